@@ -1,0 +1,14 @@
+// Each `motwin` subcommand registers itself on the CLI11 app; main.cpp only wires them.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace motwin::cli {
+
+// Every add_* function registers its subcommand and its callback. The callback sets the
+// process exit status through `exit_status`.
+void add_serve_command(CLI::App& app, int& exit_status);
+void add_tmcl_command(CLI::App& app, int& exit_status);
+void add_params_command(CLI::App& app, int& exit_status);
+
+}  // namespace motwin::cli

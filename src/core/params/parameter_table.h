@@ -1,0 +1,72 @@
+// Generic operations over a module's parameter table: lookup, access letters and ranges.
+// Every TMCL command that touches a parameter goes through here, so the rules of the
+// manuals' access columns live in one place.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "core/params/parameter.h"
+#include "core/tmcl/status.h"
+
+namespace motwin::params {
+
+template <class Owner>
+class ParameterTable {
+ public:
+  using Row = ParameterRow<Owner>;
+
+  constexpr explicit ParameterTable(std::span<const Row> rows) : rows_(rows) {}
+
+  constexpr std::span<const Row> rows() const { return rows_; }
+
+  // Rows are sorted by number (checked by is_sorted() in each module's static_assert).
+  constexpr const Row* find(uint16_t number) const {
+    size_t lo = 0;
+    size_t hi = rows_.size();
+    while (lo < hi) {
+      const size_t mid = lo + (hi - lo) / 2;
+      if (rows_[mid].info.number == number) return &rows_[mid];
+      if (rows_[mid].info.number < number) {
+        lo = mid + 1;
+      } else {
+        hi = mid;
+      }
+    }
+    return nullptr;
+  }
+
+  constexpr bool is_sorted() const {
+    for (size_t i = 1; i < rows_.size(); ++i) {
+      if (rows_[i - 1].info.number >= rows_[i].info.number) return false;
+    }
+    return true;
+  }
+
+  // Unknown parameter and unreadable parameter: status 3 (wrong type).
+  tmcl::Status read(Owner& owner, uint8_t axis, uint16_t number, int32_t& value) const {
+    const Row* row = find(number);
+    if (row == nullptr || !has(row->info.access, Access::kRead) || row->binding.get == nullptr) {
+      return tmcl::Status::kWrongType;
+    }
+    value = row->binding.get(owner, axis);
+    return tmcl::Status::kOk;
+  }
+
+  // Unknown or read-only parameter: status 3 (wrong type, docs/decisions.md); value outside
+  // the row's range: status 4 (invalid value). Nothing changes on error.
+  tmcl::Status write(Owner& owner, uint8_t axis, uint16_t number, int32_t value) const {
+    const Row* row = find(number);
+    if (row == nullptr || !has(row->info.access, Access::kWrite) || row->binding.set == nullptr) {
+      return tmcl::Status::kWrongType;
+    }
+    if (!in_range(row->info, value)) return tmcl::Status::kInvalidValue;
+    return row->binding.set(owner, axis, value);
+  }
+
+ private:
+  std::span<const Row> rows_;
+};
+
+}  // namespace motwin::params

@@ -1,0 +1,71 @@
+// What the TMCL engine needs from a module profile (TMCM-1636, TMCM-142 ...). The engine owns
+// the command semantics shared by every TMCL module; the profile owns its parameter tables,
+// motion and I/O. Called per command, never per control tick, so virtual calls are fine here.
+#pragma once
+
+#include <cstdint>
+
+#include "core/tmcl/runtime.h"
+#include "core/tmcl/status.h"
+
+namespace motwin::tmcl {
+
+struct FirmwareIdentity {
+  uint16_t module_number;     // 1636
+  uint8_t version_major;      // 1
+  uint8_t version_minor;      // 9
+  char version_string[9];     // "1636V109": 8 characters, never containing 'B'
+
+  // Command 136 type 1 (notes/tmcl.md): module << 16 | major << 8 | minor.
+  constexpr int32_t binary_version() const {
+    return static_cast<int32_t>((static_cast<uint32_t>(module_number) << 16) |
+                                (static_cast<uint32_t>(version_major) << 8) | version_minor);
+  }
+};
+
+// Serial-line settings the framing layer needs (GP 66, 76, 75). They take effect at once.
+struct SerialSettings {
+  uint8_t module_address;
+  uint8_t host_address;
+  uint8_t telegram_pause_ms;
+};
+
+class TmclDevice {
+ public:
+  virtual const FirmwareIdentity& identity() const = 0;
+  virtual uint8_t motor_count() const = 0;
+  virtual SerialSettings serial_settings() const = 0;
+  virtual TmclRuntime& runtime() = 0;
+
+  // Motion. motor < motor_count() is checked by the engine. velocity is signed: ROL negates.
+  virtual Status rotate(uint8_t motor, int32_t velocity) = 0;
+  virtual Status stop(uint8_t motor) = 0;
+  virtual Status move(uint8_t motor, uint8_t move_type, int32_t value) = 0;
+  virtual bool position_reached(uint8_t motor) const = 0;
+
+  // Axis parameters (SAP, GAP, STAP, RSAP).
+  virtual Status set_axis_parameter(uint8_t number, uint8_t motor, int32_t value) = 0;
+  virtual Status get_axis_parameter(uint8_t number, uint8_t motor, int32_t& value) = 0;
+  virtual Status store_axis_parameter(uint8_t number, uint8_t motor) = 0;
+  virtual Status restore_axis_parameter(uint8_t number, uint8_t motor) = 0;
+
+  // Global parameters (SGP, GGP, STGP, RSGP). Bank checking is the profile's.
+  virtual Status set_global_parameter(uint8_t number, uint8_t bank, int32_t value) = 0;
+  virtual Status get_global_parameter(uint8_t number, uint8_t bank, int32_t& value) = 0;
+  virtual Status store_global_parameter(uint8_t number, uint8_t bank) = 0;
+  virtual Status restore_global_parameter(uint8_t number, uint8_t bank) = 0;
+
+  // I/O (SIO, GIO).
+  virtual Status set_output(uint8_t port, uint8_t bank, int32_t value) = 0;
+  virtual Status get_input(uint8_t port, uint8_t bank, int32_t& value) = 0;
+
+  // Command 137: every stored setting back to its factory default, then applied.
+  virtual void restore_factory_defaults() = 0;
+  // Command 255 and power-up: RAM state cleared, parameters restored from the EEPROM image.
+  virtual void power_up() = 0;
+
+ protected:
+  ~TmclDevice() = default;
+};
+
+}  // namespace motwin::tmcl

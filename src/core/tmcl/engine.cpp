@@ -1,0 +1,216 @@
+#include "core/tmcl/engine.h"
+
+namespace motwin::tmcl {
+namespace {
+
+CommandResult status_only(Status status, int32_t echo) { return CommandResult{status, echo, ReplyKind::kNormal, false}; }
+
+CommandResult read_result(Status status, int32_t value, int32_t echo) {
+  if (status != Status::kOk) return status_only(status, echo);
+  return CommandResult{Status::kOk, value, ReplyKind::kNormal, true};
+}
+
+// CLE types (notes/tmcl.md): ALL 0, ETO 1, EAL 2, EDV 3, EPO 4, ESD 5.
+constexpr uint8_t kCleMasks[] = {0xFF, kErrorTimeout, kErrorExternalAlarm, kErrorDeviation, kErrorPosition,
+                                 kErrorShutdown};
+
+// CALC/CALCX operations (notes/tmcl.md): ADD 0 .. LOAD 9, CALCX adds SWAP 10. Arithmetic
+// wraps as 32-bit two's complement. Division or modulo by zero leaves the accumulator
+// unchanged and answers status 4 (docs/decisions.md).
+Status calculate(TmclRuntime& r, uint8_t operation, int32_t operand, bool with_x) {
+  const auto a = static_cast<uint32_t>(r.accumulator);
+  const auto b = static_cast<uint32_t>(operand);
+  switch (operation) {
+    case 0: r.accumulator = static_cast<int32_t>(a + b); return Status::kOk;
+    case 1: r.accumulator = static_cast<int32_t>(a - b); return Status::kOk;
+    case 2: r.accumulator = static_cast<int32_t>(a * b); return Status::kOk;
+    case 3:
+    case 4:
+      if (operand == 0) return Status::kInvalidValue;
+      if (r.accumulator == INT32_MIN && operand == -1) {  // the one overflowing quotient
+        r.accumulator = operation == 3 ? INT32_MIN : 0;
+      } else {
+        r.accumulator = operation == 3 ? r.accumulator / operand : r.accumulator % operand;
+      }
+      return Status::kOk;
+    case 5: r.accumulator = static_cast<int32_t>(a & b); return Status::kOk;
+    case 6: r.accumulator = static_cast<int32_t>(a | b); return Status::kOk;
+    case 7: r.accumulator = static_cast<int32_t>(a ^ b); return Status::kOk;
+    case 8:
+      if (with_x) {
+        r.x_register = static_cast<int32_t>(~static_cast<uint32_t>(r.x_register));
+      } else {
+        r.accumulator = static_cast<int32_t>(~a);
+      }
+      return Status::kOk;
+    case 9:
+      if (with_x) {
+        r.x_register = r.accumulator;
+      } else {
+        r.accumulator = operand;
+      }
+      return Status::kOk;
+    case 10:
+      if (!with_x) return Status::kWrongType;
+      {
+        const int32_t accumulator = r.accumulator;
+        r.accumulator = r.x_register;
+        r.x_register = accumulator;
+      }
+      return Status::kOk;
+    default:
+      return Status::kWrongType;
+  }
+}
+
+}  // namespace
+
+CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelId channel) {
+  (void)origin;  // reads report loads_accumulator; only the interpreter acts on it
+  const int32_t echo = in.value;
+  const bool motor_ok = in.motor_bank < device_.motor_count();
+  switch (in.command) {
+    case command::kRor:
+    case command::kRol: {
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      // ROL negates; -INT32_MIN does not fit and is out of every velocity range anyway.
+      if (in.command == command::kRol && in.value == INT32_MIN) return status_only(Status::kInvalidValue, echo);
+      const int32_t velocity = in.command == command::kRol ? -in.value : in.value;
+      return status_only(device_.rotate(in.motor_bank, velocity), echo);
+    }
+    case command::kMst:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.stop(in.motor_bank), echo);
+    case command::kMvp:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.move(in.motor_bank, in.type, in.value), echo);
+    case command::kSap:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.set_axis_parameter(in.type, in.motor_bank, in.value), echo);
+    case command::kGap: {
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      int32_t value = 0;
+      const Status status = device_.get_axis_parameter(in.type, in.motor_bank, value);
+      return read_result(status, value, echo);
+    }
+    case command::kStap:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.store_axis_parameter(in.type, in.motor_bank), echo);
+    case command::kRsap:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.restore_axis_parameter(in.type, in.motor_bank), echo);
+    case command::kSgp:
+      return status_only(device_.set_global_parameter(in.type, in.motor_bank, in.value), echo);
+    case command::kGgp: {
+      int32_t value = 0;
+      const Status status = device_.get_global_parameter(in.type, in.motor_bank, value);
+      return read_result(status, value, echo);
+    }
+    case command::kStgp:
+      return status_only(device_.store_global_parameter(in.type, in.motor_bank), echo);
+    case command::kRsgp:
+      return status_only(device_.restore_global_parameter(in.type, in.motor_bank), echo);
+    case command::kSio:
+      return status_only(device_.set_output(in.type, in.motor_bank, in.value), echo);
+    case command::kGio: {
+      int32_t value = 0;
+      const Status status = device_.get_input(in.type, in.motor_bank, value);
+      return read_result(status, value, echo);
+    }
+    case command::kCalc:
+      return status_only(calculate(device_.runtime(), in.type, in.value, false), echo);
+    case command::kCalcx:
+      return status_only(calculate(device_.runtime(), in.type, device_.runtime().x_register, true), echo);
+    case command::kComp:
+      device_.runtime().compare_accumulator = device_.runtime().accumulator;
+      device_.runtime().compare_operand = in.value;
+      return status_only(Status::kOk, echo);
+    case command::kAap:
+      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.set_axis_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
+    case command::kAgp:
+      return status_only(device_.set_global_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
+    // Program flow makes no sense from a host (manual 2.5.3): "command not available".
+    case command::kJc:
+    case command::kJa:
+    case command::kCsub:
+    case command::kRsub:
+    case command::kWait:
+    case command::kStop:
+      return status_only(Status::kNotAvailable, echo);
+    case command::kCle:
+      if (in.type >= sizeof(kCleMasks)) return status_only(Status::kWrongType, echo);
+      device_.runtime().error_flags &= static_cast<uint8_t>(~kCleMasks[in.type]);
+      return status_only(Status::kOk, echo);
+    case command::kGetFirmwareVersion:
+      if (in.type == 0) return CommandResult{Status::kOk, echo, ReplyKind::kVersionString, false};
+      if (in.type == 1) return CommandResult{Status::kOk, device_.identity().binary_version(), ReplyKind::kNormal, false};
+      return status_only(Status::kWrongType, echo);
+    case command::kRestoreFactoryDefaults:
+      // Manual table 10: value 1234, no reply. A wrong value is answered (status 4) so that a
+      // host waiting for a reply is not left hanging (docs/decisions.md).
+      if (in.value != kResetMagic) return status_only(Status::kInvalidValue, echo);
+      device_.restore_factory_defaults();
+      events_ = {};
+      return CommandResult{Status::kOk, echo, ReplyKind::kNone, false};
+    case command::kRequestPositionReachedEvent:
+      return request_position_event(in, channel);
+    case command::kSoftwareReset:
+      if (in.value != kResetMagic) return status_only(Status::kInvalidValue, echo);
+      return CommandResult{Status::kOk, echo, ReplyKind::kThenReset, false};
+    default:
+      return status_only(Status::kInvalidCommand, echo);
+  }
+}
+
+// Command 138: value = bit mask of motors (bit n = motor n). The normal reply goes out now;
+// a second reply (status 128, command 138, value = mask) when all of them have reached their
+// target position (docs/decisions.md).
+CommandResult TmclEngine::request_position_event(const Instruction& in, ChannelId channel) {
+  const uint32_t all_motors = (1u << device_.motor_count()) - 1u;
+  const auto mask = static_cast<uint32_t>(in.value);
+  if (mask == 0 || (mask & ~all_motors) != 0) return status_only(Status::kInvalidValue, in.value);
+  for (auto& event : events_) {
+    if (event.active && event.channel == channel && event.motor_mask == mask) return status_only(Status::kOk, in.value);
+  }
+  for (auto& event : events_) {
+    if (!event.active) {
+      event = PendingEvent{true, channel, mask};
+      return status_only(Status::kOk, in.value);
+    }
+  }
+  return status_only(Status::kInvalidValue, in.value);  // all slots taken
+}
+
+void TmclEngine::collect_events(ReplySink& sink) {
+  for (auto& event : events_) {
+    if (!event.active) continue;
+    bool reached = true;
+    for (uint8_t motor = 0; motor < device_.motor_count(); ++motor) {
+      if ((event.motor_mask & (1u << motor)) != 0 && !device_.position_reached(motor)) reached = false;
+    }
+    if (!reached) continue;
+    event.active = false;
+    sink.deliver(event.channel, Reply{to_byte(Status::kPositionReachedEvent), command::kRequestPositionReachedEvent,
+                                      static_cast<int32_t>(event.motor_mask)});
+  }
+}
+
+void TmclEngine::forget_channel(ChannelId channel) {
+  for (auto& event : events_) {
+    if (event.channel == channel) event.active = false;
+  }
+}
+
+void TmclEngine::complete_reset() {
+  events_ = {};
+  device_.power_up();
+}
+
+size_t TmclEngine::pending_event_count() const {
+  size_t n = 0;
+  for (const auto& event : events_) n += event.active ? 1 : 0;
+  return n;
+}
+
+}  // namespace motwin::tmcl

@@ -1,0 +1,82 @@
+// The TMCL command dispatcher: one instruction in, one result out, the same for a host and
+// for a stored program. Transport framing (serial, CAN, ASCII) lives in the *_link files.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "core/tmcl/device.h"
+#include "core/tmcl/instruction.h"
+#include "core/tmcl/status.h"
+
+namespace motwin::tmcl {
+
+// Identifies the host connection a request came from, so that delayed replies (command 138)
+// reach the host that asked.
+using ChannelId = uint16_t;
+
+enum class ReplyKind : uint8_t {
+  kNormal,
+  kVersionString,   // command 136 type 0: host address + 8 ASCII characters
+  kNone,            // command 137: no reply
+  kThenReset,       // command 255: reply first, then power-up
+};
+
+struct CommandResult {
+  Status status = Status::kOk;
+  int32_t value = 0;          // reply value; for reads: the value read
+  ReplyKind kind = ReplyKind::kNormal;
+  bool loads_accumulator = false;  // a read: a program copies value into the accumulator
+};
+
+// A reply as the link layers encode it.
+struct Reply {
+  uint8_t status;
+  uint8_t command;
+  int32_t value;
+};
+
+class ReplySink {
+ public:
+  virtual void deliver(ChannelId channel, const Reply& reply) = 0;
+
+ protected:
+  ~ReplySink() = default;
+};
+
+class TmclEngine {
+ public:
+  explicit TmclEngine(TmclDevice& device) : device_(device) {}
+
+  TmclDevice& device() { return device_; }
+
+  // Runs one instruction. `channel` only matters for command 138.
+  CommandResult execute(const Instruction& instruction, Origin origin, ChannelId channel = 0);
+
+  // Delivers the delayed replies that have become due (command 138). Call after each tick batch.
+  void collect_events(ReplySink& sink);
+
+  // A host connection went away: its pending events are dropped.
+  void forget_channel(ChannelId channel);
+
+  // Command 255 after its reply has gone out (and the host runtime's power-up).
+  void complete_reset();
+
+  size_t pending_event_count() const;
+
+ private:
+  struct PendingEvent {
+    bool active = false;
+    ChannelId channel = 0;
+    uint32_t motor_mask = 0;
+  };
+  static constexpr size_t kMaxPendingEvents = 16;
+
+  CommandResult request_position_event(const Instruction& in, ChannelId channel);
+
+  TmclDevice& device_;
+  std::array<PendingEvent, kMaxPendingEvents> events_{};
+};
+
+}  // namespace motwin::tmcl
