@@ -43,8 +43,9 @@ void TrapezoidRamp::step(const TrapezoidRampConfig& config, double dt_s) {
 
 void TrapezoidRamp::step_velocity_mode(const TrapezoidRampConfig& config, double dt_s) {
   const double wanted = clamp(target_velocity_, -config.max_velocity, config.max_velocity);
+  const double previous = velocity_;
   velocity_ = config.ramp_enabled ? approach(velocity_, wanted, config.acceleration * dt_s) : wanted;
-  advance(dt_s);
+  advance(previous, dt_s);
 }
 
 void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double dt_s) {
@@ -55,6 +56,7 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
   }
   const double direction = distance > 0.0 ? 1.0 : (distance < 0.0 ? -1.0 : 0.0);
   const double max_change = config.acceleration * dt_s;
+  const double previous = velocity_;
   if (!config.ramp_enabled) {
     velocity_ = direction * config.max_velocity;
   } else {
@@ -72,7 +74,7 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
       velocity_ = approach(velocity_, wanted, max_change);
     }
   }
-  const double step_distance = velocity_ * dt_s;
+  const double step_distance = 0.5 * (previous + velocity_) * dt_s;
   const bool arrives = step_distance * direction > 0.0 && std::fabs(step_distance) >= std::fabs(distance);
   const bool slow_enough = !config.ramp_enabled || std::fabs(velocity_) <= 2.0 * max_change + 1e-9;
   if (arrives && slow_enough) {
@@ -82,11 +84,12 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
     velocity_ = 0.0;
     return;
   }
-  advance(dt_s);
+  advance(previous, dt_s);
 }
 
-void TrapezoidRamp::advance(double dt_s) {
-  position_q16_ += static_cast<int64_t>(std::llround(velocity_ * dt_s * kQ16));
+// Trapezoidal integration: exact for the piecewise-constant acceleration of the ramp.
+void TrapezoidRamp::advance(double previous_velocity, double dt_s) {
+  position_q16_ += static_cast<int64_t>(std::llround(0.5 * (previous_velocity + velocity_) * dt_s * kQ16));
 }
 
 }  // namespace motwin::motion

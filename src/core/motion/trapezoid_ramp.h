@@ -55,7 +55,7 @@ class TrapezoidRamp {
  private:
   void step_velocity_mode(const TrapezoidRampConfig& config, double dt_s);
   void step_position_mode(const TrapezoidRampConfig& config, double dt_s);
-  void advance(double dt_s);
+  void advance(double previous_velocity, double dt_s);
 
   Mode mode_ = Mode::kVelocity;
   double velocity_ = 0.0;
