@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Builds Motwin twice (optimised, and with AddressSanitizer + UndefinedBehaviorSanitizer) and
+# runs every test in both builds: unit tests, the freestanding-core check and the integration
+# tests against real peers (python3-serial, sockets, pseudo-terminals).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+jobs=$(nproc 2>/dev/null || echo 2)
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build build -j"$jobs"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Debug -DMOTWIN_SANITIZE=ON -DMOTWIN_BENCH=OFF >/dev/null
+cmake --build build-asan -j"$jobs"
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status=0
+echo "== tests (optimised build) =="
+ctest --test-dir build -j"$jobs" --output-on-failure || status=1
+echo "== tests (ASan + UBSan build) =="
+ctest --test-dir build-asan -j"$jobs" --output-on-failure || status=1
+exit $status
