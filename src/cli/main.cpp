@@ -1,5 +1,7 @@
 #include <CLI/CLI.hpp>
 
+#include <string>
+
 #include "cli/commands.h"
 
 int main(int argc, char** argv) {
@@ -9,6 +11,15 @@ int main(int argc, char** argv) {
   motwin::cli::add_serve_command(app, exit_status);
   motwin::cli::add_tmcl_command(app, exit_status);
   motwin::cli::add_params_command(app, exit_status);
-  CLI11_PARSE(app, argc, argv);
+  // Usage errors look like every other error and exit with status 2 (CLI11's own codes are
+  // 100 and up); --help still exits 0.
+  app.failure_message([](const CLI::App*, const CLI::Error& error) {
+    return std::string("motwin: error: ") + error.what() + " (see --help)\n";
+  });
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    return app.exit(error) == 0 ? 0 : 2;
+  }
   return exit_status;
 }

@@ -57,6 +57,7 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
   const double direction = distance > 0.0 ? 1.0 : (distance < 0.0 ? -1.0 : 0.0);
   const double max_change = config.acceleration * dt_s;
   const double previous = velocity_;
+  bool on_braking_curve = false;
   if (!config.ramp_enabled) {
     velocity_ = direction * config.max_velocity;
   } else {
@@ -64,10 +65,13 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
     const double stopping_speed = std::sqrt(2.0 * config.acceleration * std::fabs(distance));
     const double wanted = direction * (stopping_speed < config.max_velocity ? stopping_speed : config.max_velocity);
     const bool moving_towards_target = velocity_ * direction > 0.0;
+    // Accelerating ends up to a tick past the braking point; within a few ticks' worth of
+    // velocity the axis joins the braking curve at once, so it arrives without overshoot.
+    const double join_tolerance = 3.0 * max_change + 1e-9;
     if (moving_towards_target && std::fabs(velocity_) > std::fabs(wanted) &&
-        std::fabs(velocity_) - max_change <= std::fabs(wanted)) {
-      // On the braking curve: follow it exactly so that the axis arrives without overshoot.
+        std::fabs(velocity_) - join_tolerance <= std::fabs(wanted)) {
       velocity_ = wanted;
+      on_braking_curve = true;
     } else {
       // Accelerating, or too fast to stop in time after a target change: the deceleration
       // stays limited, the axis overshoots and comes back.
@@ -76,7 +80,8 @@ void TrapezoidRamp::step_position_mode(const TrapezoidRampConfig& config, double
   }
   const double step_distance = 0.5 * (previous + velocity_) * dt_s;
   const bool arrives = step_distance * direction > 0.0 && std::fabs(step_distance) >= std::fabs(distance);
-  const bool slow_enough = !config.ramp_enabled || std::fabs(velocity_) <= 2.0 * max_change + 1e-9;
+  const bool slow_enough =
+      !config.ramp_enabled || on_braking_curve || std::fabs(velocity_) <= 2.0 * max_change + 1e-9;
   if (arrives && slow_enough) {
     // distance is exact (a Q16 difference), so this lands exactly on the target while keeping
     // the wrap count of the counter.

@@ -1,0 +1,273 @@
+// `motwin serve`: runs one virtual module and serves TMCL over TCP and/or a pseudo-terminal
+// until SIGINT or SIGTERM.
+//
+// Output contract (stdout, one line each, flushed):
+//   motwin: tmcm-1636 (1636V109) eeprom <path|none>
+//   endpoint tmcl-tcp 127.0.0.1:<port>            one per --tmcl-tcp
+//   endpoint tmcl-pty <LINK> </dev/pts/N>         for --tmcl-pty
+//   ready
+//   output GPO0 1 at <sim seconds>                whenever an output changes
+// Errors before `ready`: one `motwin: error: ...` line on stderr, exit status 2.
+#include <algorithm>
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <sys/signalfd.h>
+#include <unistd.h>
+
+#include "cli/cli_errors.h"
+#include "cli/commands.h"
+#include "host/host_runtime.h"
+#include "host/module_registry.h"
+#include "host/pacing.h"
+#include "host/pty_endpoint.h"
+#include "host/state_dir.h"
+#include "host/tcp_server.h"
+#include "sim/scenario.h"
+#include "sim/signals.h"
+
+namespace motwin::cli {
+namespace {
+
+// How often a lagging simulation is reported on stderr, at most.
+constexpr uint64_t kLagReportIntervalUs = 5'000'000;
+
+struct ServeArguments {
+  std::string module = "tmcm-1636";
+  std::vector<std::string> tcp_endpoints;
+  std::string pty_link;
+  std::string state_dir;
+  std::string speed = "realtime";
+  std::vector<std::string> assignments;
+  std::string scenario_path;
+};
+
+struct ServeError {
+  std::string message;
+};
+
+void print_line(const std::string& line) {
+  std::fputs(line.c_str(), stdout);
+  std::fputc('\n', stdout);
+  std::fflush(stdout);
+}
+
+// SIGINT and SIGTERM arrive through a descriptor in the loop, so that shutdown happens between
+// two loop iterations and never inside a write of the EEPROM image.
+class ShutdownSignals {
+ public:
+  ShutdownSignals() {
+    sigemptyset(&mask_);
+    sigaddset(&mask_, SIGINT);
+    sigaddset(&mask_, SIGTERM);
+    ::sigprocmask(SIG_BLOCK, &mask_, &previous_mask_);
+    fd_ = ::signalfd(-1, &mask_, SFD_NONBLOCK | SFD_CLOEXEC);
+    // A client that disconnects while we write must not kill the server.
+    ::signal(SIGPIPE, SIG_IGN);
+  }
+  ShutdownSignals(const ShutdownSignals&) = delete;
+  ShutdownSignals& operator=(const ShutdownSignals&) = delete;
+  ~ShutdownSignals() {
+    if (fd_ >= 0) ::close(fd_);
+    ::sigprocmask(SIG_SETMASK, &previous_mask_, nullptr);
+  }
+  int fd() const { return fd_; }
+
+ private:
+  sigset_t mask_{};
+  sigset_t previous_mask_{};
+  int fd_ = -1;
+};
+
+// Signal bounds are short decimals: "4095", "-50", "0.5".
+std::string fmt_range(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%g", value);
+  return buffer;
+}
+
+std::string format_sim_seconds(uint64_t sim_time_us) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%llu.%06llu", static_cast<unsigned long long>(sim_time_us / 1'000'000u),
+                static_cast<unsigned long long>(sim_time_us % 1'000'000u));
+  return buffer;
+}
+
+int run_serve(const ServeArguments& arguments) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  ShutdownSignals shutdown_signals;
+  if (shutdown_signals.fd() < 0) throw ServeError{"cannot set up signal handling"};
+
+  // Everything the user typed is checked before any file or socket is touched.
+  const host::ModuleDescriptor* descriptor = host::find_module(arguments.module);
+  if (descriptor == nullptr) {
+    throw ServeError{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
+  }
+  std::string error;
+  const std::optional<host::Pacing> pacing = host::Pacing::parse(arguments.speed, error);
+  if (!pacing) throw ServeError{error};
+
+  host::ModuleOptions options;
+  for (const std::string& text : arguments.assignments) {
+    const std::optional<sim::SignalAssignment> assignment =
+        sim::parse_signal_assignment(descriptor->input_signals(), text, error);
+    if (!assignment) throw ServeError{"--set " + text + ": " + error};
+    options.initial_inputs.push_back(host::InitialInput{std::string(assignment->signal->name), assignment->value});
+  }
+  std::optional<sim::ScenarioParseResult> scenario;
+  if (!arguments.scenario_path.empty()) {
+    scenario = sim::load_scenario_file(arguments.scenario_path, descriptor->input_signals());
+    if (!scenario->ok()) throw ServeError{scenario->error};
+  }
+  std::vector<host::TcpEndpointSpec> tcp_specs;
+  for (const std::string& text : arguments.tcp_endpoints) {
+    const std::optional<host::TcpEndpointSpec> spec = host::parse_tcp_endpoint(text, error);
+    if (!spec) throw ServeError{"--tmcl-tcp: " + error};
+    tcp_specs.push_back(*spec);
+  }
+  if (tcp_specs.empty() && arguments.pty_link.empty()) tcp_specs.push_back(host::TcpEndpointSpec{});
+
+  if (arguments.state_dir != host::kNoStateDir) {
+    if (!arguments.state_dir.empty()) {
+      options.state_dir = arguments.state_dir;
+    } else if (std::optional<std::filesystem::path> default_dir = host::default_state_dir()) {
+      options.state_dir = *default_dir;
+    } else {
+      throw ServeError{"no home directory for the default state directory; give --state-dir DIR (or none)"};
+    }
+  }
+  host::MakeModuleResult made = descriptor->make(options);
+  if (!made.module) throw ServeError{made.error};
+  host::VirtualModule& module = *made.module;
+
+  host::HostRuntime runtime(module, *pacing);
+  if (scenario) runtime.set_scenario(std::move(scenario->events));
+
+  // Endpoints are destroyed before the runtime they are attached to.
+  std::vector<std::unique_ptr<host::TmclTcpServer>> tcp_servers;
+  for (const host::TcpEndpointSpec& spec : tcp_specs) {
+    host::TmclTcpServer::OpenResult opened = host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec);
+    if (!opened.server) throw ServeError{opened.error};
+    tcp_servers.push_back(std::move(opened.server));
+  }
+  std::unique_ptr<host::TmclPtyEndpoint> pty;
+  if (!arguments.pty_link.empty()) {
+    host::TmclPtyEndpoint::OpenResult opened =
+        host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), arguments.pty_link);
+    if (!opened.endpoint) throw ServeError{opened.error};
+    pty = std::move(opened.endpoint);
+  }
+
+  runtime.set_output_listener([](const sim::OutputChange& change) {
+    print_line("output " + std::string(change.signal) + " " + std::to_string(change.level) + " at " +
+               format_sim_seconds(change.sim_time_us));
+  });
+  runtime.loop().watch(shutdown_signals.fd(), POLLIN, [&runtime, &shutdown_signals](short) {
+    signalfd_siginfo info{};
+    while (::read(shutdown_signals.fd(), &info, sizeof(info)) == static_cast<ssize_t>(sizeof(info))) {
+    }
+    runtime.loop().request_stop();
+  });
+  uint64_t reported_lag_us = 0;
+  std::function<void()> report_lag = [&] {
+    const uint64_t dropped_us = runtime.pacer().dropped_backlog_sim_us();
+    if (dropped_us > reported_lag_us) {
+      std::fprintf(stderr, "motwin: the simulation cannot keep up with --speed %s; it now lags %.1f ms of sim time\n",
+                   runtime.pacer().pacing().describe().c_str(), static_cast<double>(dropped_us) / 1000.0);
+      reported_lag_us = dropped_us;
+    }
+    runtime.loop().add_timer_after(kLagReportIntervalUs, report_lag);
+  };
+  runtime.loop().add_timer_after(kLagReportIntervalUs, report_lag);
+
+  print_line("motwin: " + std::string(module.name()) + " (" + std::string(module.firmware_version()) + ") eeprom " +
+             module.nvm_location());
+  for (const auto& server : tcp_servers) print_line("endpoint tmcl-tcp " + server->local_address());
+  if (pty) print_line("endpoint tmcl-pty " + pty->link_path() + " " + pty->device_path());
+  runtime.start();
+  print_line("ready");
+
+  runtime.run();
+
+  runtime.loop().unwatch(shutdown_signals.fd());
+  pty.reset();
+  tcp_servers.clear();
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app, int& exit_status) {
+  auto arguments = std::make_shared<ServeArguments>();
+  CLI::App* serve = app.add_subcommand("serve", "Run a virtual module and serve TMCL to host software");
+  serve->add_option("--module", arguments->module, "Module to run: " + host::module_names())
+      ->type_name("NAME")
+      ->capture_default_str();
+  serve->add_option("--tmcl-tcp", arguments->tcp_endpoints,
+                    "Serve TMCL over TCP (raw 9-byte frames, as PyTrinamic's socket interface sends them) on "
+                    "HOST:PORT; HOST defaults to 127.0.0.1, port 0 picks a free port. Repeatable. Without any "
+                    "--tmcl-tcp or --tmcl-pty: 127.0.0.1:5000")
+      ->type_name("HOST:PORT")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--tmcl-pty", arguments->pty_link,
+                    "Serve TMCL on a pseudo-terminal and make LINK a symbolic link to it (for pyserial and other "
+                    "serial-port software; the baud rate, and GP 65, have no effect)")
+      ->type_name("LINK");
+  serve->add_option("--state-dir", arguments->state_dir,
+                    "Directory of the EEPROM image file <module>.eeprom (default $XDG_DATA_HOME/motwin or "
+                    "~/.local/share/motwin); \"none\" keeps the image in memory only")
+      ->type_name("DIR");
+  serve->add_option("--speed", arguments->speed,
+                    "Simulated time: realtime (follows the wall clock), fast (as fast as the CPU allows) or a "
+                    "factor of real time such as 2 or 0.5")
+      ->type_name("realtime|fast|FACTOR")
+      ->capture_default_str();
+  serve->add_option("--set", arguments->assignments,
+                    "Set an input before start-up, e.g. --set GPI0=1 --set VSUPPLY=26.5. Repeatable")
+      ->type_name("SIGNAL=VALUE")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--scenario", arguments->scenario_path,
+                    "Scenario file: lines \"<time_s> <SIGNAL> <value>\" (sim seconds), # comments")
+      ->type_name("FILE");
+
+  std::string signals_help;
+  for (const host::ModuleDescriptor& module : host::registered_modules()) {
+    signals_help += "\nSignals of " + std::string(module.name) + " (--set, --scenario):\n";
+    for (const sim::SignalInfo& signal : module.input_signals()) {
+      char line[160];
+      const std::string range = signal.whole_numbers_only && signal.min == 0 && signal.max == 1
+                                    ? "0/1"
+                                    : fmt_range(signal.min) + ".." + fmt_range(signal.max);
+      std::snprintf(line, sizeof(line), "  %-9s %-9s %s\n", std::string(signal.name).c_str(), range.c_str(),
+                    std::string(signal.description).c_str());
+      signals_help += line;
+    }
+  }
+  serve->footer(
+      "Prints \"motwin: <module> (<firmware>) eeprom <path>\", one \"endpoint ...\" line per endpoint and "
+      "\"ready\" on stdout, then \"output GPO0 1 at <sim seconds>\" for each output change. SIGINT or SIGTERM "
+      "stops the server cleanly (exit status 0); a start-up error exits with status 2.\n" +
+      signals_help);
+
+  serve->callback([arguments, &exit_status] {
+    try {
+      exit_status = run_serve(*arguments);
+    } catch (const ServeError& serve_error) {
+      print_error(serve_error.message);
+      exit_status = kExitUsageError;
+    } catch (const std::exception& unexpected) {
+      print_error(unexpected.what());
+      exit_status = kExitUsageError;
+    }
+  });
+}
+
+}  // namespace motwin::cli

@@ -1,0 +1,120 @@
+// The EEPROM image of a virtual module as a file in the state directory,
+// `<state-dir>/<module-name>.eeprom`, written atomically so that a crash (even SIGKILL in the
+// middle of a STAP storm) always leaves either the old or the new image, both complete.
+//
+// File layout (little-endian), see docs/host-runtime.md:
+//   0  8  magic "MOTWINEE"
+//   8  4  file format version (kFormatVersion)
+//  12  4  header size (kHeaderSize)
+//  16 32  module name, ASCII, NUL padded ("tmcm-1636")
+//  48  4  module NVM layout version (e.g. Tmcm1636::kNvmLayoutVersion)
+//  52  4  payload size in bytes
+//  56  4  CRC-32 of the payload
+//  60  4  CRC-32 of bytes 0..59
+//  64     payload: the module's image, byte for byte
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "board/non_volatile_memory.h"
+
+namespace motwin::host {
+
+// One diagnostic line (without a trailing newline); the default writes it to stderr.
+using LogSink = std::function<void(const std::string& line)>;
+void log_to_stderr(const std::string& line);
+
+struct EepromImageIdentity {
+  std::string module_name;  // at most EepromFile::kMaxModuleNameLength characters
+  uint32_t layout_version;  // bumped by the module whenever its stored layout changes
+  size_t payload_size;
+};
+
+// Fills `image` (payload_size bytes) with the module's factory defaults.
+using FactoryImageFormatter = std::function<void(uint8_t* image, size_t size)>;
+
+enum class EepromLoadOutcome : uint8_t {
+  kLoaded,           // the file was valid
+  kCreated,          // there was no file: the factory image was written
+  kReplacedDamaged,  // damaged or foreign: reported, kept as <path>.damaged, factory image written
+};
+
+// Steps of an atomic write, for fault injection in tests.
+enum class PersistStep : uint8_t { kOpenTemporary, kWriteTemporary, kSyncTemporary, kRename, kSyncDirectory };
+
+class EepromFile final : public board::NonVolatileMemory {
+ public:
+  static constexpr char kMagic[8] = {'M', 'O', 'T', 'W', 'I', 'N', 'E', 'E'};
+  static constexpr uint32_t kFormatVersion = 1;
+  static constexpr size_t kHeaderSize = 64;
+  static constexpr size_t kMaxModuleNameLength = 31;
+
+  struct OpenResult {
+    std::unique_ptr<EepromFile> file;
+    std::string error;  // set when file is null: the state directory is unusable
+  };
+
+  // Creates `state_dir` if needed, takes an exclusive lock (`<path>.lock`, so that two servers
+  // never write one image), removes a temporary file left by a crash, and loads the image.
+  // A missing, damaged or foreign image is replaced by the factory image (written to disk);
+  // damaged or foreign also logs exactly one line through `log`.
+  static OpenResult open(const std::filesystem::path& state_dir, const EepromImageIdentity& identity,
+                         const FactoryImageFormatter& format_factory_image, const LogSink& log = log_to_stderr);
+
+  static std::filesystem::path image_path(const std::filesystem::path& state_dir, std::string_view module_name);
+
+  EepromFile(const EepromFile&) = delete;
+  EepromFile& operator=(const EepromFile&) = delete;
+  ~EepromFile();
+
+  // board::NonVolatileMemory.
+  size_t size() const override { return image_.size(); }
+  const uint8_t* data() const override { return image_.data(); }
+  // Updates the image and rewrites the whole file atomically (temporary file, fsync, rename,
+  // fsync of the directory) before returning true. On false the image in memory is unchanged,
+  // the temporary file is gone, the file holds a complete image (normally the old one) and one
+  // line saying why went to the log.
+  bool write(size_t offset, const uint8_t* bytes, size_t length) override;
+
+  const std::filesystem::path& path() const { return path_; }
+  EepromLoadOutcome load_outcome() const { return load_outcome_; }
+  // errno of the last failed write (0 if none failed).
+  int last_write_errno() const { return last_write_errno_; }
+  size_t persist_count() const { return persist_count_; }
+
+  // Test hook: called before each step of a write; a non-zero return is taken as that step
+  // failing with that errno.
+  void set_fault_injector(std::function<int(PersistStep)> injector) { fault_injector_ = std::move(injector); }
+
+  // Encodes a complete file for `payload` (exposed for tests and tools).
+  static std::vector<uint8_t> encode(const EepromImageIdentity& identity, const uint8_t* payload);
+  // Empty when `file_bytes` is a valid image for `identity`, otherwise why not ("bad magic" ...).
+  static std::string validate(const EepromImageIdentity& identity, const std::vector<uint8_t>& file_bytes);
+
+ private:
+  EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd, LogSink log);
+  // Writes image_ to disk atomically; on failure returns the errno.
+  int persist();
+  int injected_fault(PersistStep step) const { return fault_injector_ ? fault_injector_(step) : 0; }
+
+  std::filesystem::path path_;
+  std::filesystem::path temporary_path_;
+  EepromImageIdentity identity_;
+  int directory_fd_;
+  int lock_fd_;
+  std::vector<uint8_t> image_;
+  EepromLoadOutcome load_outcome_ = EepromLoadOutcome::kLoaded;
+  int last_write_errno_ = 0;
+  size_t persist_count_ = 0;
+  std::function<int(PersistStep)> fault_injector_;
+  LogSink log_;
+};
+
+}  // namespace motwin::host

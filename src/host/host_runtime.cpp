@@ -1,0 +1,67 @@
+#include "host/host_runtime.h"
+
+#include <algorithm>
+
+namespace motwin::host {
+
+HostRuntime::HostRuntime(VirtualModule& module, Pacing pacing)
+    : module_(module), pacer_(pacing, module.tick_period_us()), service_(module.engine(), loop_) {}
+
+void HostRuntime::set_scenario(std::vector<sim::ScenarioEvent> events) {
+  scenario_.emplace(std::move(events), module_.signals());
+}
+
+void HostRuntime::start() {
+  if (scenario_) scenario_->apply_due(sim_time_us());
+  pacer_.start(monotonic_now_us(), sim_time_us());
+}
+
+void HostRuntime::advance_ticks(uint64_t ticks) {
+  const uint64_t tick_us = module_.tick_period_us();
+  while (ticks > 0) {
+    uint64_t batch = ticks;
+    if (scenario_) {
+      scenario_->apply_due(sim_time_us());
+      if (const std::optional<uint64_t> next_us = scenario_->next_event_time_us()) {
+        // Stop at the first tick that starts at or after the event.
+        const uint64_t ticks_to_event = (*next_us - sim_time_us() + tick_us - 1) / tick_us;
+        batch = std::min(batch, std::max<uint64_t>(ticks_to_event, 1));
+      }
+    }
+    module_.run_ticks(batch);
+    ticks -= batch;
+  }
+  // Events due exactly now apply before any host request at this sim time.
+  if (scenario_) scenario_->apply_due(sim_time_us());
+  service_.deliver_events();
+  report_output_changes();
+}
+
+void HostRuntime::step(uint64_t max_wait_us) {
+  const uint64_t due = pacer_.ticks_due(monotonic_now_us(), sim_time_us());
+  const uint64_t chunk = std::min(due, pacer_.chunk_ticks());
+  if (chunk > 0) advance_ticks(chunk);
+  // wait_us() is 0 while a whole batch is already due (catching up, or fast mode).
+  const uint64_t now_us = monotonic_now_us();
+  const uint64_t wait_us = now_us < busy_poll_until_us_ ? 0 : pacer_.wait_us(now_us, sim_time_us());
+  loop_.poll_once(std::min(wait_us, max_wait_us));
+  service_.serve_queued();
+  report_output_changes();
+  if (service_.served_request_count() != served_requests_seen_) {
+    served_requests_seen_ = service_.served_request_count();
+    busy_poll_until_us_ = monotonic_now_us() + kBusyPollAfterRequestUs;
+  }
+}
+
+void HostRuntime::run() {
+  while (!loop_.stop_requested()) step();
+}
+
+void HostRuntime::report_output_changes() {
+  output_scratch_.clear();
+  module_.signals().take_output_changes(output_scratch_);
+  if (!output_listener_) return;
+  for (const sim::OutputChange& change : output_scratch_) output_listener_(change);
+}
+
+}  // namespace motwin::host

@@ -1,0 +1,73 @@
+// The host runtime of one virtual module: a poll() loop that interleaves simulation tick
+// batches (paced by Pacer) with the transports, the TMCL request service, scenario events and
+// output-change reporting. Single-threaded; transports are attached by the caller (see
+// src/cli/serve_command.cpp) and must be destroyed before the runtime.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "host/event_loop.h"
+#include "host/pacing.h"
+#include "host/tmcl_host_service.h"
+#include "host/virtual_module.h"
+#include "sim/scenario.h"
+
+namespace motwin::host {
+
+class HostRuntime {
+ public:
+  // After serving a request the loop polls without sleeping this long: a host in a request/reply
+  // exchange sends its next frame within microseconds, and waking a sleeping process on another
+  // CPU can cost more than the whole exchange (docs/host-runtime.md). An idle server still sleeps.
+  static constexpr uint64_t kBusyPollAfterRequestUs = 200;
+
+  using OutputListener = std::function<void(const sim::OutputChange& change)>;
+
+  HostRuntime(VirtualModule& module, Pacing pacing);
+  HostRuntime(const HostRuntime&) = delete;
+  HostRuntime& operator=(const HostRuntime&) = delete;
+
+  VirtualModule& module() { return module_; }
+  EventLoop& loop() { return loop_; }
+  TmclHostService& service() { return service_; }
+  const Pacer& pacer() const { return pacer_; }
+
+  // Events are applied to module().signals() at their sim times.
+  void set_scenario(std::vector<sim::ScenarioEvent> events);
+  const sim::ScenarioPlayer* scenario() const { return scenario_ ? &*scenario_ : nullptr; }
+  // Called for every output change, in order, after the tick batch or request that caused it.
+  void set_output_listener(OutputListener listener) { output_listener_ = std::move(listener); }
+
+  // Anchors pacing at the current wall time and applies the scenario events due at start.
+  void start();
+  // One loop iteration: the due ticks (at most one chunk of Pacer::kChunkSimUs), then waiting
+  // for I/O until the next batch is due (but at most `max_wait_us`), then the callbacks, then
+  // queued TMCL requests.
+  void step(uint64_t max_wait_us = EventLoop::kWaitForever);
+  // step() until loop().request_stop().
+  void run();
+
+  // Runs exactly `ticks` ticks now, whatever the pacing; scenario events land on their exact
+  // tick however the ticks are batched (determinism). Then sends due command 138 replies and
+  // reports output changes.
+  void advance_ticks(uint64_t ticks);
+  uint64_t sim_time_us() const { return module_.sim_time_us(); }
+
+ private:
+  void report_output_changes();
+
+  VirtualModule& module_;
+  Pacer pacer_;
+  EventLoop loop_;
+  TmclHostService service_;
+  std::optional<sim::ScenarioPlayer> scenario_;
+  OutputListener output_listener_;
+  std::vector<sim::OutputChange> output_scratch_;
+  uint64_t served_requests_seen_ = 0;
+  uint64_t busy_poll_until_us_ = 0;
+};
+
+}  // namespace motwin::host

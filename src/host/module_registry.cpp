@@ -1,0 +1,44 @@
+#include "host/module_registry.h"
+
+#include "host/tmcm1636_virtual_module.h"
+#include "sim/tmcm1636_sim_io.h"
+
+namespace motwin::host {
+namespace {
+
+constexpr ModuleDescriptor kModules[] = {
+    {"tmcm-1636", "TMCM-1636 1-axis BLDC/DC servo module, TMCL firmware 1636V109", &sim::Tmcm1636SimIo::signal_table,
+     &Tmcm1636VirtualModule::make},
+};
+
+}  // namespace
+
+std::span<const ModuleDescriptor> registered_modules() { return kModules; }
+
+const ModuleDescriptor* find_module(std::string_view name) {
+  for (const ModuleDescriptor& module : kModules) {
+    if (module.name == name) return &module;
+  }
+  return nullptr;
+}
+
+std::string module_names() {
+  std::string names;
+  for (const ModuleDescriptor& module : kModules) {
+    if (!names.empty()) names += ", ";
+    names += module.name;
+  }
+  return names;
+}
+
+MakeModuleResult make_module(std::string_view name, const ModuleOptions& options) {
+  const ModuleDescriptor* module = find_module(name);
+  if (module == nullptr) {
+    MakeModuleResult result;
+    result.error = "unknown module \"" + std::string(name) + "\" (available: " + module_names() + ")";
+    return result;
+  }
+  return module->make(options);
+}
+
+}  // namespace motwin::host

@@ -1,0 +1,53 @@
+// The modules `motwin serve --module NAME` can run. Adding a module (TMCM-142, TMCM-3216) means
+// one VirtualModule implementation and one row in module_registry.cpp.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "host/eeprom_file.h"
+#include "host/virtual_module.h"
+#include "sim/signals.h"
+
+namespace motwin::host {
+
+struct InitialInput {
+  std::string signal;
+  double value;
+};
+
+struct ModuleOptions {
+  // Directory of the EEPROM image file; nullopt keeps the image in memory (factory defaults).
+  std::optional<std::filesystem::path> state_dir;
+  // Input levels set before power-up (`--set`), already checked against input_signals.
+  std::vector<InitialInput> initial_inputs;
+  LogSink log = log_to_stderr;
+};
+
+struct MakeModuleResult {
+  std::unique_ptr<VirtualModule> module;  // powered up and ready for its first tick
+  std::string error;                      // when module is null
+};
+
+struct ModuleDescriptor {
+  std::string_view name;     // "tmcm-1636"
+  std::string_view summary;  // one line for --help
+  std::span<const sim::SignalInfo> (*input_signals)();
+  MakeModuleResult (*make)(const ModuleOptions& options);
+};
+
+std::span<const ModuleDescriptor> registered_modules();
+// nullptr for an unknown name.
+const ModuleDescriptor* find_module(std::string_view name);
+// "tmcm-1636, ..." for messages.
+std::string module_names();
+
+// An unknown name or an unusable state directory gives an error, never an exception.
+MakeModuleResult make_module(std::string_view name, const ModuleOptions& options);
+
+}  // namespace motwin::host

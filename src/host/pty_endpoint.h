@@ -1,0 +1,76 @@
+// TMCL over a pseudo-terminal, for host software that expects a serial port (pyserial,
+// TMCL-IDE under Wine, terminal programs): `motwin serve --tmcl-pty /tmp/tmcm1636` creates a
+// pty and a symbolic link to its slave side (/dev/pts/N).
+//
+// The endpoint keeps a descriptor of the slave open itself, so that clients may open and close
+// the device as often as they like: without it the master reports a hangup (POLLHUP, EIO)
+// whenever no client has the slave open, and a poll() loop would spin on it. The slave is in
+// raw mode; the baud rate a client sets (and GP 65) has no effect on a pty. The master is in
+// packet mode so that a client flushing its input (pyserial does on open) also discards the
+// replies still waiting here: a new client never receives an old client's replies.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/tmcl/serial_link.h"
+#include "host/eeprom_file.h"
+#include "host/event_loop.h"
+#include "host/tmcl_host_service.h"
+
+namespace motwin::host {
+
+class TmclPtyEndpoint final : public ReplyChannel {
+ public:
+  // Replies nobody reads pile up in the pty, then here; beyond this they are dropped (a serial
+  // line with no listener loses them too), and a client's input flush drops them all.
+  static constexpr size_t kMaxPendingOutputBytes = 64 * 1024;
+
+  struct OpenResult {
+    std::unique_ptr<TmclPtyEndpoint> endpoint;
+    std::string error;
+  };
+  // Creates the pty and the link. An existing symbolic link is replaced when it is stale or
+  // points into /dev/pts (left by an earlier run); anything else at `link_path` is an error.
+  static OpenResult open(EventLoop& loop, TmclHostService& service, const std::string& link_path,
+                         LogSink log = log_to_stderr);
+
+  TmclPtyEndpoint(const TmclPtyEndpoint&) = delete;
+  TmclPtyEndpoint& operator=(const TmclPtyEndpoint&) = delete;
+  // Removes the link (if it still points to our pty) and closes the pty.
+  ~TmclPtyEndpoint();
+
+  const std::string& link_path() const { return link_path_; }
+  const std::string& device_path() const { return device_path_; }
+  tmcl::ChannelId channel() const { return channel_; }
+
+  // ReplyChannel.
+  void send_reply(const uint8_t* bytes, size_t length) override;
+  void on_request_served() override { update_poll_events(); }
+
+ private:
+  TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, int master_fd, int slave_fd, std::string link_path,
+                  std::string device_path, LogSink log);
+  void on_events(short revents);
+  void read_some();
+  void flush();
+  void update_poll_events();
+
+  EventLoop& loop_;
+  TmclHostService& service_;
+  int master_fd_;
+  int slave_fd_;
+  std::string link_path_;
+  std::string device_path_;
+  LogSink log_;
+  tmcl::ChannelId channel_ = 0;
+  tmcl::SerialFrameDecoder decoder_;  // serial timing: 5 ms resync gap
+  std::vector<uint8_t> output_;
+  bool input_suspended_ = false;      // after an unexpected hangup, see on_events()
+  bool reported_dropped_output_ = false;
+};
+
+}  // namespace motwin::host

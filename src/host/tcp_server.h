@@ -1,0 +1,80 @@
+// TMCL over TCP, as PyTrinamic's socket interface speaks it: raw 9-byte frames back to back in
+// both directions, no extra framing. Any number of clients (up to kMaxClients) share the module
+// through TmclHostService; each has its own frame decoder, so a half frame or garbage from one
+// client never affects another.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <sys/socket.h>
+
+#include "host/eeprom_file.h"
+#include "host/event_loop.h"
+#include "host/tmcl_host_service.h"
+
+namespace motwin::host {
+
+inline constexpr std::string_view kDefaultTcpHost = "127.0.0.1";
+inline constexpr uint16_t kDefaultTcpPort = 5000;
+
+struct TcpEndpointSpec {
+  std::string host = std::string(kDefaultTcpHost);
+  uint16_t port = kDefaultTcpPort;  // 0: the system picks a free port
+};
+
+// "HOST:PORT", ":PORT", "PORT" (host 127.0.0.1) or "[IPv6]:PORT". On failure sets `error`.
+std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::string& error);
+
+class TmclTcpServer {
+ public:
+  // TCP may deliver one frame in two segments; a serial-style 5 ms gap could then split a
+  // frame a client sent in one piece. 100 ms keeps "pause to resync" working for a client
+  // that lost sync while no real network stalls a frame that long (docs/host-runtime.md).
+  static constexpr uint32_t kResyncGapUs = 100'000;
+  static constexpr size_t kMaxClients = 64;
+  // A client that lets this much reply data pile up is not reading: it is disconnected.
+  static constexpr size_t kMaxPendingOutputBytes = 64 * 1024;
+
+  struct OpenResult {
+    std::unique_ptr<TmclTcpServer> server;
+    std::string error;  // "cannot listen on 127.0.0.1:5000: Address already in use"
+  };
+  static OpenResult open(EventLoop& loop, TmclHostService& service, const TcpEndpointSpec& spec,
+                         LogSink log = log_to_stderr);
+
+  TmclTcpServer(const TmclTcpServer&) = delete;
+  TmclTcpServer& operator=(const TmclTcpServer&) = delete;
+  // Closes every connection and the listening socket.
+  ~TmclTcpServer();
+
+  std::string local_address() const;  // "127.0.0.1:40321", "[::1]:5000"
+  uint16_t local_port() const;
+  size_t client_count() const { return connections_.size(); }
+
+ private:
+  class Connection;
+  TmclTcpServer(EventLoop& loop, TmclHostService& service, int listen_fd, LogSink log);
+  // `after_other_callbacks`: a second look at a full server, once the connections that closed
+  // in the same loop iteration have been removed.
+  void accept_clients(bool after_other_callbacks = false);
+  void close_connection(Connection& connection, const std::string& reason);
+
+  EventLoop& loop_;
+  TmclHostService& service_;
+  int listen_fd_;
+  LogSink log_;
+  std::map<tmcl::ChannelId, std::shared_ptr<Connection>> connections_;
+  // Deferred work holds a weak reference: it must not touch a server destroyed meanwhile.
+  std::shared_ptr<bool> lifetime_ = std::make_shared<bool>(true);
+};
+
+// "127.0.0.1:5000" or "[::1]:5000" for an IPv4 or IPv6 socket address.
+std::string format_socket_address(const sockaddr_storage& address);
+
+}  // namespace motwin::host

@@ -1,0 +1,42 @@
+// A virtual module as the host runtime sees it, whatever the module: a name, a TMCL engine,
+// a control tick, an EEPROM image and named board signals. Module-specific code lives behind
+// make_module() (module_registry.h); the event loop, transports and `motwin serve` only use
+// this interface.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "board/non_volatile_memory.h"
+#include "core/tmcl/engine.h"
+#include "sim/signals.h"
+
+namespace motwin::host {
+
+class VirtualModule {
+ public:
+  virtual ~VirtualModule() = default;
+
+  virtual std::string_view name() const = 0;              // "tmcm-1636"
+  virtual std::string_view firmware_version() const = 0;  // "1636V109"
+  virtual tmcl::TmclEngine& engine() = 0;
+
+  // Fixed simulation step of the module (TMCM-1636: 50 µs).
+  virtual uint32_t tick_period_us() const = 0;
+  // Runs `count` ticks; one virtual call per batch keeps the per-tick path free of them.
+  virtual void run_ticks(uint64_t count) = 0;
+  void tick() { run_ticks(1); }
+  // Ticks run since start-up (not reset by command 255, which restarts the firmware only).
+  virtual uint64_t tick_count() const = 0;
+  uint64_t sim_time_us() const { return tick_count() * tick_period_us(); }
+
+  virtual board::NonVolatileMemory& nvm() = 0;
+  // Path of the EEPROM image file, or "none" when it is kept in memory only.
+  virtual std::string nvm_location() const = 0;
+
+  // Inputs to set (--set, scenario files) and outputs to log.
+  virtual sim::SignalBoard& signals() = 0;
+};
+
+}  // namespace motwin::host

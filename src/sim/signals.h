@@ -1,0 +1,69 @@
+// Named input and output signals of a simulated board: what `motwin serve --set NAME=VALUE`
+// and scenario files address. Each simulated board lists its signals as data (SignalInfo), so
+// that parsing, range checks and error messages are the same for every module.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace motwin::sim {
+
+struct SignalInfo {
+  std::string_view name;         // upper case, e.g. "GPI0", "VSUPPLY"
+  double min;                    // accepted range, inclusive
+  double max;
+  bool whole_numbers_only;       // levels and raw ADC counts
+  std::string_view description;  // for help text, e.g. "supply voltage in volts"
+};
+
+// An output that changed, stamped with the simulated time of the change.
+struct OutputChange {
+  std::string_view signal;  // e.g. "GPO0"
+  int32_t level;
+  uint64_t sim_time_us;
+};
+
+class SignalBoard {
+ public:
+  virtual ~SignalBoard() = default;
+
+  virtual std::span<const SignalInfo> input_signals() const = 0;
+  // `name` must be one of input_signals() and `value` must pass check_signal_value().
+  virtual void set_input(std::string_view name, double value) = 0;
+  // Inputs and outputs by name (outputs as 0/1); nullopt for an unknown name.
+  virtual std::optional<double> read_signal(std::string_view name) const = 0;
+  // Appends the output changes recorded since the last call, oldest first.
+  virtual void take_output_changes(std::vector<OutputChange>& out) = 0;
+};
+
+// Signal names are matched without regard to case ("gpi0" is GPI0).
+bool same_signal_name(std::string_view a, std::string_view b);
+
+// Case-insensitive lookup; returns nullptr for an unknown name.
+const SignalInfo* find_signal(std::span<const SignalInfo> signals, std::string_view name);
+
+// Empty when `value` is acceptable for `signal`, otherwise what was expected, for example
+// "GPI0 takes 0 or 1" or "VSUPPLY takes 0 to 100 (supply voltage in volts)".
+std::string check_signal_value(const SignalInfo& signal, double value);
+
+// "GPI0, GPI1, ..., REF_H": for "unknown signal" messages.
+std::string signal_names(std::span<const SignalInfo> signals);
+
+// A finite decimal number ("1", "-0.5", "26.5", "1e3"); nullopt for anything else.
+std::optional<double> parse_number(std::string_view text);
+
+struct SignalAssignment {
+  const SignalInfo* signal = nullptr;
+  double value = 0;
+};
+
+// Parses "NAME=VALUE" (as given to --set). On failure returns nullopt and sets `error`.
+std::optional<SignalAssignment> parse_signal_assignment(std::span<const SignalInfo> signals, std::string_view text,
+                                                        std::string& error);
+
+}  // namespace motwin::sim

@@ -1,0 +1,71 @@
+// Simulated general I/O of the TMCM-1636: digital inputs GPI0..3, analog inputs AI0/AI1,
+// supply voltage and driver temperature (as the raw ADC_VM / ADC_TEMP counts the firmware
+// converts back, manual 2.6.13/2.6.14), outputs GPO0/1 and the reference switch inputs.
+// The host sets inputs by name (--set, scenario files) and logs output changes.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "board/tmcm1636_io.h"
+#include "sim/signals.h"
+
+namespace motwin::sim {
+
+class Tmcm1636SimIo final : public board::Tmcm1636Io, public SignalBoard {
+ public:
+  static constexpr int32_t kDefaultSupplyMillivolt = 24000;
+  static constexpr double kDefaultTemperatureCelsius = 25.0;
+  // Output changes kept between two take_output_changes() calls; older ones are dropped (and
+  // counted) so that a program toggling an output every tick cannot grow memory unbounded.
+  static constexpr size_t kMaxPendingOutputChanges = 4096;
+
+  // GPI0..3, AI0, AI1, VSUPPLY, TEMP, REF_R, REF_L, REF_H.
+  static std::span<const SignalInfo> signal_table();
+
+  Tmcm1636SimIo();
+
+  // board::Tmcm1636Io.
+  bool digital_input(uint8_t port) const override;
+  uint16_t analog_input(uint8_t channel) const override;
+  void set_digital_output(uint8_t port, bool on) override;
+  bool digital_output(uint8_t port) const override;
+  bool reference_switch_level(board::ReferenceSwitch which) const override;
+
+  // Typed setters. Out-of-range ports are ignored; values are clamped to what the ADC reads.
+  void set_digital_input(uint8_t port, bool level);
+  void set_analog_input_raw(uint8_t channel, uint16_t raw);  // AI0 (0) and AI1 (1), 0..4095
+  void set_supply_millivolt(int32_t millivolt);
+  int32_t supply_millivolt() const { return supply_millivolt_; }
+  void set_temperature_celsius(double celsius);
+  double temperature_celsius() const { return temperature_celsius_; }
+  void set_reference_switch_level(board::ReferenceSwitch which, bool level);
+
+  // Simulated time used to stamp output changes; the host module wrapper sets it per tick.
+  void set_sim_time_us(uint64_t sim_time_us) { sim_time_us_ = sim_time_us; }
+  size_t dropped_output_changes() const { return dropped_output_changes_; }
+
+  // SignalBoard.
+  std::span<const SignalInfo> input_signals() const override { return signal_table(); }
+  void set_input(std::string_view name, double value) override;
+  std::optional<double> read_signal(std::string_view name) const override;
+  void take_output_changes(std::vector<OutputChange>& out) override;
+
+ private:
+  std::array<bool, kDigitalInputCount> digital_inputs_{};
+  std::array<uint16_t, 2> analog_inputs_raw_{};
+  int32_t supply_millivolt_ = kDefaultSupplyMillivolt;
+  uint16_t supply_raw_ = 0;
+  double temperature_celsius_ = kDefaultTemperatureCelsius;
+  uint16_t temperature_raw_ = 0;
+  std::array<bool, kDigitalOutputCount> digital_outputs_{};
+  std::array<bool, 3> reference_switch_levels_{};
+  uint64_t sim_time_us_ = 0;
+  std::vector<OutputChange> output_changes_;
+  size_t dropped_output_changes_ = 0;
+};
+
+}  // namespace motwin::sim

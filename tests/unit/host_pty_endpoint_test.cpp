@@ -1,0 +1,168 @@
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "host/pty_endpoint.h"
+#include "support/host_test_support.h"
+
+namespace motwin::host {
+namespace {
+
+using testing::Bytes;
+using testing::reply;
+using testing::request;
+using testing::slice;
+
+constexpr uint8_t kGap = 6, kSap = 5, kSgp = 9;
+
+// What a serial-port client does: open the device, read and write raw bytes.
+class SerialTestClient {
+ public:
+  explicit SerialTestClient(const std::string& path) { fd_ = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC); }
+  SerialTestClient(const SerialTestClient&) = delete;
+  SerialTestClient& operator=(const SerialTestClient&) = delete;
+  ~SerialTestClient() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  bool is_open() const { return fd_ >= 0; }
+  int fd() const { return fd_; }
+  void send(const Bytes& bytes) const { ASSERT_EQ(::write(fd_, bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size())); }
+  bool has(size_t count) {
+    uint8_t buffer[256];
+    const ssize_t n = ::read(fd_, buffer, sizeof(buffer));
+    if (n > 0) received_.insert(received_.end(), buffer, buffer + n);
+    return received_.size() >= count;
+  }
+  Bytes take() {
+    Bytes out;
+    out.swap(received_);
+    return out;
+  }
+
+ private:
+  int fd_ = -1;
+  Bytes received_;
+};
+
+class PtyEndpointTest : public ::testing::Test {
+ protected:
+  std::string link() const { return (scratch_.path() / "tmcm1636").string(); }
+
+  void open_endpoint() {
+    TmclPtyEndpoint::OpenResult opened =
+        TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link(), [](const std::string&) {});
+    ASSERT_TRUE(opened.endpoint) << opened.error;
+    endpoint_ = std::move(opened.endpoint);
+  }
+  Bytes exchange(SerialTestClient& client, const Bytes& frame) {
+    client.send(frame);
+    EXPECT_TRUE(testing::pump_until([this] { rig_.step(); }, [&] { return client.has(9); }));
+    return client.take();
+  }
+
+  testing::ScratchDirectory scratch_;
+  testing::ModuleOnRuntime rig_;
+  std::unique_ptr<TmclPtyEndpoint> endpoint_;
+};
+
+TEST_F(PtyEndpointTest, the_link_points_to_a_raw_pseudo_terminal_that_answers_tmcl) {
+  open_endpoint();
+  EXPECT_EQ(std::filesystem::read_symlink(link()).string(), endpoint_->device_path());
+  EXPECT_EQ(endpoint_->device_path().rfind("/dev/pts/", 0), 0u);
+  SerialTestClient client(link());
+  ASSERT_TRUE(client.is_open());
+  termios settings{};
+  ASSERT_EQ(::tcgetattr(client.fd(), &settings), 0);
+  EXPECT_EQ(settings.c_lflag & (ECHO | ICANON), 0u);  // raw: no echo of our replies back to us
+  EXPECT_EQ(exchange(client, request(kGap, 43, 0, 0)), (Bytes{0x02, 0x01, 0x64, 0x06, 0x00, 0x00, 0x0F, 0xA0, 0x1C}));
+}
+
+TEST_F(PtyEndpointTest, clients_may_open_and_close_the_device_repeatedly) {
+  open_endpoint();
+  for (int round = 0; round < 5; ++round) {
+    SCOPED_TRACE(round);
+    SerialTestClient client(link());
+    ASSERT_TRUE(client.is_open());
+    EXPECT_EQ(exchange(client, request(kSap, 43, 0, 1000 + round)), reply(100, kSap, 1000 + round));
+  }
+  // Nobody has the device open: the master must be quiet, not hung up (no busy loop).
+  EXPECT_EQ(rig_.runtime->loop().poll_once(0), 0u);
+  SerialTestClient last(link());
+  EXPECT_EQ(exchange(last, request(kGap, 43, 0, 0)), reply(100, kGap, 1004));
+}
+
+TEST_F(PtyEndpointTest, a_pause_resynchronises_after_a_half_frame) {
+  open_endpoint();
+  SerialTestClient client(link());
+  client.send(slice(request(kGap, 43, 0, 0), 0, 4));
+  // Longer than the 5 ms resync gap, measured by the loop's clock.
+  const uint64_t start = monotonic_now_us();
+  while (monotonic_now_us() - start < 20'000) rig_.step();
+  EXPECT_EQ(exchange(client, request(kGap, 43, 0, 0)), reply(100, kGap, 4000));
+}
+
+TEST_F(PtyEndpointTest, a_client_that_flushes_on_open_never_gets_an_old_clients_replies) {
+  open_endpoint();
+  {
+    // Sends 3000 requests and never reads a reply: far more than the pty holds.
+    SerialTestClient flooder(link());
+    Bytes flood;
+    for (int i = 0; i < 3000; ++i) {
+      const Bytes frame = request(kSgp, 20, 2, 5);
+      flood.insert(flood.end(), frame.begin(), frame.end());
+    }
+    size_t written = 0;
+    ASSERT_TRUE(testing::pump_until([this] { rig_.step(); }, [&] {
+      const ssize_t n = ::write(flooder.fd(), flood.data() + written, flood.size() - written);
+      if (n > 0) written += static_cast<size_t>(n);
+      return written == flood.size() && rig_.runtime->service().served_request_count() == 3000;
+    }));
+  }
+  // What pyserial does on open: discard whatever input is waiting.
+  SerialTestClient client(link());
+  ASSERT_EQ(::tcflush(client.fd(), TCIFLUSH), 0);
+  EXPECT_EQ(exchange(client, request(kGap, 43, 0, 0)), reply(100, kGap, 4000));
+  for (int i = 0; i < 20; ++i) rig_.step();
+  EXPECT_FALSE(client.has(1));  // nothing stale behind it
+}
+
+TEST_F(PtyEndpointTest, a_stale_link_is_replaced_and_removed_at_shutdown) {
+  std::filesystem::create_symlink("/dev/pts/999999", link());
+  open_endpoint();
+  EXPECT_EQ(std::filesystem::read_symlink(link()).string(), endpoint_->device_path());
+  endpoint_.reset();
+  EXPECT_FALSE(std::filesystem::is_symlink(link()));
+}
+
+TEST_F(PtyEndpointTest, a_regular_file_or_a_link_to_something_else_is_not_replaced) {
+  std::ofstream(link()) << "precious";
+  TmclPtyEndpoint::OpenResult opened = TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
+  EXPECT_FALSE(opened.endpoint);
+  EXPECT_EQ(opened.error, link() + " exists and is not a symbolic link; not replacing it");
+  std::filesystem::remove(link());
+
+  const std::string target = (scratch_.path() / "real-device").string();
+  std::ofstream(target) << "x";
+  std::filesystem::create_symlink(target, link());
+  opened = TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
+  EXPECT_FALSE(opened.endpoint);
+  EXPECT_EQ(opened.error, link() + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it");
+  EXPECT_EQ(std::filesystem::read_symlink(link()).string(), target);
+}
+
+TEST_F(PtyEndpointTest, a_link_in_a_missing_directory_is_an_error) {
+  TmclPtyEndpoint::OpenResult opened =
+      TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), (scratch_.path() / "no" / "tty").string());
+  EXPECT_FALSE(opened.endpoint);
+  EXPECT_NE(opened.error.find("No such file or directory"), std::string::npos) << opened.error;
+}
+
+}  // namespace
+}  // namespace motwin::host
