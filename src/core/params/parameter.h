@@ -132,6 +132,22 @@ struct Binding {
   tmcl::Status (*set)(Owner& owner, uint8_t axis, int32_t value) = nullptr;
 };
 
+// A binding to one plain field of a part of the owner: `Part` is a function returning that part
+// (for example the axis config struct), `Field` a pointer to the member. Writable fields store
+// the value as it comes; read-only ones (Writable = false) reject writes.
+template <class Owner, auto Part, auto Field, bool Writable = true>
+constexpr Binding<Owner> field_binding() {
+  Binding<Owner> binding;
+  binding.get = [](Owner& owner, uint8_t) { return static_cast<int32_t>(Part(owner).*Field); };
+  if constexpr (Writable) {
+    binding.set = [](Owner& owner, uint8_t, int32_t value) {
+      Part(owner).*Field = value;
+      return tmcl::Status::kOk;
+    };
+  }
+  return binding;
+}
+
 template <class Owner>
 struct ParameterRow {
   ParameterInfo info;

@@ -20,30 +20,26 @@ constexpr int64_t kMin32 = INT32_MIN;
 constexpr int64_t kMax32 = INT32_MAX;
 constexpr int64_t kMaxU32 = UINT32_MAX;
 
+AxisConfig& axis_config(Tmcm1636& m) { return m.axis().config; }
+AxisState& axis_state(Tmcm1636& m) { return m.axis().state; }
+GlobalConfig& global_config(Tmcm1636& m) { return m.global_config(); }
+
 // A stored setting of the axis: plain read and write.
 template <int32_t AxisConfig::*Field>
 constexpr Binding<Tmcm1636> config_field() {
-  return {[](Tmcm1636& m, uint8_t) { return m.axis().config.*Field; },
-          [](Tmcm1636& m, uint8_t, int32_t value) {
-            m.axis().config.*Field = value;
-            return Status::kOk;
-          }};
+  return params::field_binding<Tmcm1636, axis_config, Field>();
 }
 
 // A live value that the firmware computes; read-only.
 template <auto Field>
 constexpr Binding<Tmcm1636> state_value() {
-  return {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.axis().state.*Field); }, nullptr};
+  return params::field_binding<Tmcm1636, axis_state, Field, false>();
 }
 
 // A live value a host may also write, without side effects (debug values, brake release).
 template <int32_t AxisState::*Field>
 constexpr Binding<Tmcm1636> state_field() {
-  return {[](Tmcm1636& m, uint8_t) { return m.axis().state.*Field; },
-          [](Tmcm1636& m, uint8_t, int32_t value) {
-            m.axis().state.*Field = value;
-            return Status::kOk;
-          }};
+  return params::field_binding<Tmcm1636, axis_state, Field>();
 }
 
 template <int kIndex>
@@ -57,11 +53,7 @@ constexpr Binding<Tmcm1636> debug_value() {
 
 template <int32_t GlobalConfig::*Field>
 constexpr Binding<Tmcm1636> global_field() {
-  return {[](Tmcm1636& m, uint8_t) { return m.global_config().*Field; },
-          [](Tmcm1636& m, uint8_t, int32_t value) {
-            m.global_config().*Field = value;
-            return Status::kOk;
-          }};
+  return params::field_binding<Tmcm1636, global_config, Field>();
 }
 
 constexpr Binding<Tmcm1636> kTargetTorque{
