@@ -25,8 +25,7 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
   }
   for (const InitialInput& input : options.initial_inputs) module->io_.set_input(input.signal, input.value);
   module->device_.emplace(*module->nvm_, module->io_);
-  module->engine_.emplace(*module->device_);
-  module->device_->power_up();
+  module->device_->engine().power_up();
   result.module = std::move(module);
   return result;
 }

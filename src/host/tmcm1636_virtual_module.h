@@ -29,7 +29,7 @@ class Tmcm1636VirtualModule final : public VirtualModule {
   // VirtualModule.
   std::string_view name() const override { return Device::kName; }
   std::string_view firmware_version() const override { return Device::kIdentity.version_string; }
-  tmcl::TmclEngine& engine() override { return *engine_; }
+  tmcl::TmclEngine& engine() override { return device_->engine(); }
   uint32_t tick_period_us() const override { return modules::tmcm1636::kControlTickUs; }
   void run_ticks(uint64_t count) override;
   uint64_t tick_count() const override { return tick_count_; }
@@ -49,7 +49,6 @@ class Tmcm1636VirtualModule final : public VirtualModule {
   board::NonVolatileMemory* nvm_ = nullptr;
   // Constructed once the image is chosen: the device keeps references to it and to io_.
   std::optional<Device> device_;
-  std::optional<tmcl::TmclEngine> engine_;
   uint64_t tick_count_ = 0;
 };
 

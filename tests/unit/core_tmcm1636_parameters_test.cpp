@@ -23,10 +23,11 @@ TEST(Tmcm1636Parameters, axis_table_has_every_row_of_manual_table_11) {
   EXPECT_EQ(table, manual);
 }
 
-TEST(Tmcm1636Parameters, global_table_has_table_13) {
+TEST(Tmcm1636Parameters, global_table_has_table_13_plus_gp_85_and_129) {
+  // GP 85 is described in manual 6.4, GP 129 (download mode) in notes/tmcl.md.
   std::set<int> table;
   for (const auto& row : Tmcm1636::global_parameters().rows()) table.insert(row.info.number);
-  EXPECT_EQ(table, (std::set<int>{65, 66, 69, 70, 71, 75, 76, 77, 128, 130, 132}));
+  EXPECT_EQ(table, (std::set<int>{65, 66, 69, 70, 71, 75, 76, 77, 85, 128, 129, 130, 132}));
 }
 
 TEST(Tmcm1636Parameters, every_writable_stored_parameter_reads_its_default_after_power_up) {
@@ -94,7 +95,7 @@ TEST(Tmcm1636Parameters, bank_0_writes_are_stored_automatically) {
   Tmcm1636Rig rig;
   ASSERT_EQ(rig.command(9, 77, 0, 0).status, 100);
   ASSERT_EQ(rig.command(9, 75, 0, 20).status, 100);
-  rig.module.power_up();
+  rig.engine.power_up();
   EXPECT_EQ(rig.command(10, 77, 0, 0).value, 0);
   EXPECT_EQ(rig.command(10, 75, 0, 0).value, 20);
   EXPECT_EQ(rig.send(tmcl::encode_request(1, tmcl::Instruction{10, 75, 0, 0})).delay_ms, 20) << "GP 75 delays replies";
@@ -109,14 +110,14 @@ TEST(Tmcm1636Parameters, factory_defaults_restore_everything_and_send_no_reply) 
   EXPECT_EQ(response.length, 0u);
   EXPECT_EQ(rig.gap(43), 4000);
   EXPECT_EQ(rig.command(10, 66, 0, 0).value, 1) << "address back to 1";
-  rig.module.power_up();
+  rig.engine.power_up();
   EXPECT_EQ(rig.gap(43), 4000) << "and stored as such";
 }
 
 TEST(Tmcm1636Parameters, out_of_range_stored_values_are_not_loaded) {
   Tmcm1636Rig rig;
   tmcl::put_le32(rig.nvm.mutable_data() + Tmcm1636::kNvmLayout.axis_parameter(0, 43), 999999);
-  rig.module.power_up();
+  rig.engine.power_up();
   EXPECT_EQ(rig.gap(43), 4000);
   EXPECT_EQ(rig.command(8, 43, 0, 0).status, 4);
 }

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 
+#include "core/tmcl/program_memory.h"
 #include "core/tmcl/runtime.h"
 #include "core/tmcl/status.h"
 
@@ -59,10 +60,20 @@ class TmclDevice {
   virtual Status set_output(uint8_t port, uint8_t bank, int32_t value) = 0;
   virtual Status get_input(uint8_t port, uint8_t bank, int32_t& value) = 0;
 
-  // Command 137: every stored setting back to its factory default, then applied.
+  // Command 137: every stored setting back to its factory default in the EEPROM image (the
+  // engine then powers the module up, so RAM follows).
   virtual void restore_factory_defaults() = 0;
   // Command 255 and power-up: RAM state cleared, parameters restored from the EEPROM image.
   virtual void power_up() = 0;
+
+  // Standalone mode. nullptr: the module has no program memory.
+  virtual ProgramMemory* program_memory() { return nullptr; }
+  // GP 77: start the stored program after power-up.
+  virtual bool autostart() const { return false; }
+  // Conditions of WAIT REFSW / LIMSW / RFS and the stop-switch interrupts.
+  virtual bool home_switch_active(uint8_t /*motor*/) const { return false; }
+  virtual bool stop_switch_active(uint8_t /*motor*/, bool /*left*/) const { return false; }
+  virtual bool reference_search_running(uint8_t /*motor*/) const { return false; }
 
  protected:
   ~TmclDevice() = default;

@@ -63,11 +63,112 @@ Status calculate(TmclRuntime& r, uint8_t operation, int32_t operand, bool with_x
   }
 }
 
+// Bank 3 (interrupt configuration) belongs to the interpreter on every TMCL module.
+constexpr uint8_t kInterruptBank = 3;
+
+bool is_control_command(uint8_t command) {
+  return (command >= command::kStopApplication && command <= command::kEnterAsciiMode) ||
+         command == command::kSoftwareReset;
+}
+
 }  // namespace
 
+void TmclEngine::power_up() {
+  events_ = {};
+  device_.power_up();
+  ProgramMemory* memory = device_.program_memory();
+  if (memory != nullptr) memory->load();
+  interpreter_.reset();
+  device_.runtime().application_status = ApplicationStatus::kStopped;
+  if (memory != nullptr && device_.autostart()) interpreter_.run(true, 0);
+}
+
+// Download mode (command 132): instructions from the host are stored, not executed, and
+// answered with status 101 (notes/tmcl.md).
+CommandResult TmclEngine::store_downloaded(const Instruction& in) {
+  TmclRuntime& runtime = device_.runtime();
+  ProgramMemory* memory = device_.program_memory();
+  if (memory == nullptr || !memory->stage(runtime.download_address, in)) return status_only(Status::kInvalidValue, in.value);
+  ++runtime.download_address;
+  return status_only(Status::kStoredInProgram, in.value);
+}
+
+// Commands 128..135 (manual table 10).
+CommandResult TmclEngine::control_command(const Instruction& in) {
+  TmclRuntime& runtime = device_.runtime();
+  ProgramMemory* memory = device_.program_memory();
+  if (memory == nullptr) return status_only(Status::kInvalidCommand, in.value);
+  switch (in.command) {
+    case command::kStopApplication:
+      return status_only(interpreter_.stop(), in.value);
+    case command::kRunApplication:
+      if (in.type > 1) return status_only(Status::kWrongType, in.value);
+      return status_only(interpreter_.run(in.type == 1, static_cast<uint32_t>(in.value)), in.value);
+    case command::kStepApplication:
+      return status_only(interpreter_.step(), in.value);
+    case command::kResetApplication:
+      interpreter_.reset();
+      return status_only(Status::kOk, in.value);
+    case command::kEnterDownloadMode:
+      if (static_cast<uint32_t>(in.value) >= memory->capacity()) return status_only(Status::kInvalidValue, in.value);
+      interpreter_.stop();
+      runtime.download_mode = true;
+      runtime.download_address = static_cast<uint32_t>(in.value);
+      return status_only(Status::kOk, in.value);
+    case command::kExitDownloadMode: {
+      const bool was_downloading = runtime.download_mode;
+      runtime.download_mode = false;
+      if (was_downloading && !memory->commit()) return status_only(Status::kEepromLocked, in.value);
+      return status_only(Status::kOk, in.value);
+    }
+    case command::kReadProgramMemory: {
+      // Reply layout (docs/tmcl-programs.md): type 0 -> command byte = stored opcode, value =
+      // stored value; type 1 -> command byte = stored opcode, value = type << 8 | motor.
+      Instruction stored;
+      if (in.type > 1) return status_only(Status::kWrongType, in.value);
+      if (!memory->read(static_cast<uint32_t>(in.value), stored)) return status_only(Status::kInvalidValue, in.value);
+      CommandResult result{Status::kOk, in.type == 0 ? stored.value : (stored.type << 8) | stored.motor_bank,
+                           ReplyKind::kNormal, false};
+      result.reply_command = stored.command;
+      return result;
+    }
+    case command::kGetApplicationStatus: {
+      const auto mode = static_cast<uint32_t>(runtime.application_status);
+      const uint32_t wait = interpreter_.waiting() ? 1u : 0u;
+      switch (in.type) {
+        case 0: return CommandResult{Status::kOk, static_cast<int32_t>((mode << 24) | (wait << 16) | (runtime.download_address & 0xFFFF)), ReplyKind::kNormal, false};
+        case 1: return CommandResult{Status::kOk, static_cast<int32_t>((mode << 24) | (wait << 16) | (runtime.program_counter & 0xFFFF)), ReplyKind::kNormal, false};
+        case 2: return CommandResult{Status::kOk, runtime.accumulator, ReplyKind::kNormal, false};
+        case 3: return CommandResult{Status::kOk, runtime.x_register, ReplyKind::kNormal, false};
+        case 4: return CommandResult{Status::kOk, static_cast<int32_t>((static_cast<uint32_t>(interpreter_.stop_reason()) << 16) | (interpreter_.stop_address() & 0xFFFF)), ReplyKind::kNormal, false};
+        default: return status_only(Status::kWrongType, in.value);
+      }
+    }
+    default:
+      return status_only(Status::kInvalidCommand, in.value);
+  }
+}
+
 CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelId channel) {
-  (void)origin;  // reads report loads_accumulator; only the interpreter acts on it
   const int32_t echo = in.value;
+  if (origin == Origin::kHost && device_.runtime().download_mode && !is_control_command(in.command)) {
+    return store_downloaded(in);
+  }
+  if (in.command >= command::kStopApplication && in.command <= command::kGetApplicationStatus) {
+    if (origin == Origin::kProgram) return status_only(Status::kInvalidCommand, echo);
+    return control_command(in);
+  }
+  // Interrupt configuration: SGP/GGP/AGP on bank 3.
+  if (in.motor_bank == kInterruptBank &&
+      (in.command == command::kSgp || in.command == command::kGgp || in.command == command::kAgp)) {
+    if (in.command == command::kGgp) {
+      int32_t value = 0;
+      const Status status = interpreter_.get_interrupt_parameter(in.type, value);
+      return read_result(status, value, echo);
+    }
+    const int32_t value = in.command == command::kSgp ? in.value : device_.runtime().accumulator;
+    return status_only(interpreter_.set_interrupt_parameter(in.type, value), echo);
+  }
   const bool motor_ok = in.motor_bank < device_.motor_count();
   switch (in.command) {
     case command::kRor:
@@ -117,6 +218,8 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       const Status status = device_.get_input(in.type, in.motor_bank, value);
       return read_result(status, value, echo);
     }
+    case command::kNop:
+      return status_only(Status::kOk, echo);
     case command::kCalc:
       return status_only(calculate(device_.runtime(), in.type, in.value, false), echo);
     case command::kCalcx:
@@ -151,7 +254,7 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       // host waiting for a reply is not left hanging (docs/decisions.md).
       if (in.value != kResetMagic) return status_only(Status::kInvalidValue, echo);
       device_.restore_factory_defaults();
-      events_ = {};
+      power_up();
       return CommandResult{Status::kOk, echo, ReplyKind::kNone, false};
     case command::kRequestPositionReachedEvent:
       return request_position_event(in, channel);
@@ -202,10 +305,7 @@ void TmclEngine::forget_channel(ChannelId channel) {
   }
 }
 
-void TmclEngine::complete_reset() {
-  events_ = {};
-  device_.power_up();
-}
+void TmclEngine::complete_reset() { power_up(); }
 
 size_t TmclEngine::pending_event_count() const {
   size_t n = 0;

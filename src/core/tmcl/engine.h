@@ -8,6 +8,7 @@
 
 #include "core/tmcl/device.h"
 #include "core/tmcl/instruction.h"
+#include "core/tmcl/interpreter.h"
 #include "core/tmcl/status.h"
 
 namespace motwin::tmcl {
@@ -28,6 +29,7 @@ struct CommandResult {
   int32_t value = 0;          // reply value; for reads: the value read
   ReplyKind kind = ReplyKind::kNormal;
   bool loads_accumulator = false;  // a read: a program copies value into the accumulator
+  int16_t reply_command = -1;      // >= 0: command byte of the reply (134); else the request's
 };
 
 // A reply as the link layers encode it.
@@ -47,9 +49,17 @@ class ReplySink {
 
 class TmclEngine {
  public:
-  explicit TmclEngine(TmclDevice& device) : device_(device) {}
+  explicit TmclEngine(TmclDevice& device) : device_(device), interpreter_(*this) {}
 
   TmclDevice& device() { return device_; }
+  TmclInterpreter& interpreter() { return interpreter_; }
+
+  // Power-up of the firmware: the profile restores its parameters, the program memory is
+  // loaded, and the stored program starts if autostart (GP 77) is on.
+  void power_up();
+  // One control tick at simulated time now_us: the stored program advances by at most one
+  // instruction.
+  void tick(uint64_t now_us) { interpreter_.tick(now_us); }
 
   // Runs one instruction. `channel` only matters for command 138.
   CommandResult execute(const Instruction& instruction, Origin origin, ChannelId channel = 0);
@@ -74,9 +84,12 @@ class TmclEngine {
   static constexpr size_t kMaxPendingEvents = 16;
 
   CommandResult request_position_event(const Instruction& in, ChannelId channel);
+  CommandResult control_command(const Instruction& in);
+  CommandResult store_downloaded(const Instruction& in);
 
   TmclDevice& device_;
   std::array<PendingEvent, kMaxPendingEvents> events_{};
+  TmclInterpreter interpreter_;
 };
 
 }  // namespace motwin::tmcl

@@ -28,8 +28,17 @@ struct TmclRuntime {
   int32_t compare_operand = 0;
   ApplicationStatus application_status = ApplicationStatus::kStopped;
   uint32_t program_counter = 0;
+  bool download_mode = false;       // GP 129
+  uint32_t download_address = 0;    // next address a downloaded instruction goes to
 
-  void clear_registers() { *this = TmclRuntime{}; }
+  // Command 131: registers, flags and program counter cleared (download state kept).
+  void clear_registers() {
+    const bool download = download_mode;
+    const uint32_t address = download_address;
+    *this = TmclRuntime{};
+    download_mode = download;
+    download_address = address;
+  }
 };
 
 }  // namespace motwin::tmcl

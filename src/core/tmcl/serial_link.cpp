@@ -76,8 +76,9 @@ SerialResponse serve_serial_frame(TmclEngine& engine, const Frame& frame, Channe
     case ReplyKind::kNormal:
       break;
   }
-  response.bytes = encode_reply(now.host_address, now.module_address,
-                                Reply{to_byte(result.status), instruction.command, result.value});
+  const uint8_t reply_command =
+      result.reply_command >= 0 ? static_cast<uint8_t>(result.reply_command) : instruction.command;
+  response.bytes = encode_reply(now.host_address, now.module_address, Reply{to_byte(result.status), reply_command, result.value});
   return response;
 }
 

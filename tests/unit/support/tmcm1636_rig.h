@@ -36,11 +36,11 @@ struct Tmcm1636Rig {
   Tmcm1636Nvm nvm;
   ScriptedTmcm1636Io io;
   Tmcm1636 module{nvm, io};
-  tmcl::TmclEngine engine{module};
+  tmcl::TmclEngine& engine{module.engine()};
 
   Tmcm1636Rig() {
     Tmcm1636::format_factory_image(nvm.mutable_data(), nvm.size());
-    module.power_up();
+    engine.power_up();
   }
 
   tmcl::SerialResponse send(const tmcl::Frame& frame, tmcl::ChannelId channel = 0) {

@@ -41,6 +41,12 @@ void Tmcm1636::format_factory_image(uint8_t* image, size_t size) {
                      static_cast<int32_t>(row.info.default_value));
     }
   }
+  // An empty program memory holds STOP everywhere, so autostart (GP 77 = 1 by default) of a
+  // module without a program stops at once.
+  for (uint32_t address = 0; address < kNvmLayout.program_capacity; ++address) {
+    tmcl::encode_program_record(tmcl::Instruction{tmcl::command::kStop, 0, 0, 0},
+                                image + kNvmLayout.program_offset + address * tmcl::kProgramRecordBytes);
+  }
 }
 
 bool Tmcm1636::store_value(uint32_t offset, int32_t value) {
@@ -63,7 +69,7 @@ void Tmcm1636::power_up() {
   axis_.config = AxisConfig{};
   global_ = GlobalConfig{};
   user_variables_.fill(0);
-  runtime_.clear_registers();
+  runtime_ = tmcl::TmclRuntime{};
   tick_timer_ms_ = 0;
   tick_fraction_ = 0;
   if (nvm_.size() < kNvmLayout.total_size) return;
@@ -77,18 +83,18 @@ void Tmcm1636::power_up() {
     const int32_t value = stored_value(kNvmLayout.global_parameter(static_cast<uint8_t>(row.info.number)));
     if (params::in_range(row.info, value)) row.binding.set(*this, kBankGlobal, value);
   }
+  if (global_.skip_user_variable_restore != 0) return;
   for (uint8_t i = 0; i < kStorableUserVariables; ++i) {
     user_variables_[i] = stored_value(kNvmLayout.user_variable(i));
   }
 }
 
-// Command 137: the parameter part of the image back to factory values (a stored TMCL program
-// is kept), then a power-up so that RAM matches (docs/tmcm-1636.md).
+// Command 137: the parameter part of the image back to factory values; a stored TMCL program
+// is kept (docs/decisions.md). The engine powers the module up afterwards.
 void Tmcm1636::restore_factory_defaults() {
   static uint8_t image[kNvmLayout.total_size];
   format_factory_image(image, sizeof image);
   last_store_failed_ = !nvm_.write(0, image, kNvmLayout.program_offset);
-  power_up();
 }
 
 void Tmcm1636::tick() {
@@ -98,6 +104,13 @@ void Tmcm1636::tick() {
     tick_fraction_ = 0;
     ++tick_timer_ms_;
   }
+  engine_.tick(tick_count_ * kControlTickUs);
+}
+
+bool Tmcm1636::home_switch_active(uint8_t /*motor*/) const { return axis_.state.home_switch_active != 0; }
+
+bool Tmcm1636::stop_switch_active(uint8_t /*motor*/, bool left) const {
+  return (left ? axis_.state.left_switch_active : axis_.state.right_switch_active) != 0;
 }
 
 tmcl::SerialSettings Tmcm1636::serial_settings() const {

@@ -13,7 +13,9 @@
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
 #include "core/params/parameter_table.h"
 #include "core/tmcl/device.h"
+#include "core/tmcl/engine.h"
 #include "core/tmcl/nvm_layout.h"
+#include "core/tmcl/program_memory.h"
 
 namespace motwin::modules::tmcm1636 {
 
@@ -27,6 +29,7 @@ struct GlobalConfig {
   int32_t telegram_pause_ms = 0;       // GP 75
   int32_t serial_host_address = 2;     // GP 76
   int32_t auto_start_mode = 1;         // GP 77
+  int32_t skip_user_variable_restore = 0;  // GP 85 (manual 6.4): 1 = user variables start at 0
 };
 
 inline constexpr size_t kUserVariableCount = 256;     // bank 2
@@ -49,10 +52,15 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   // Writes the factory image (every stored value at its default) into `image`.
   static void format_factory_image(uint8_t* image, size_t size);
 
-  // Does not touch `nvm` beyond reading it: call power_up() to start.
+  // Does not touch `nvm` beyond reading it: call engine().power_up() to start.
   Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io);
+  Tmcm1636(const Tmcm1636&) = delete;
+  Tmcm1636& operator=(const Tmcm1636&) = delete;
 
-  // One 50 µs control tick.
+  // The TMCL firmware of this module: command dispatcher and interpreter.
+  tmcl::TmclEngine& engine() { return engine_; }
+
+  // One 50 µs control tick: the axis, then at most one instruction of a running program.
   void tick();
   uint64_t tick_count() const { return tick_count_; }
   uint32_t tick_timer_ms() const { return tick_timer_ms_; }
@@ -85,6 +93,10 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   tmcl::Status get_input(uint8_t port, uint8_t bank, int32_t& value) override;
   void restore_factory_defaults() override;
   void power_up() override;
+  tmcl::ProgramMemory* program_memory() override { return &program_; }
+  bool autostart() const override { return global_.auto_start_mode != 0; }
+  bool home_switch_active(uint8_t motor) const override;
+  bool stop_switch_active(uint8_t motor, bool left) const override;
 
   // Used by the table bindings.
   void set_tick_timer_ms(uint32_t ms) { tick_timer_ms_ = ms; tick_fraction_ = 0; }
@@ -104,6 +116,10 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   uint32_t tick_timer_ms_ = 0;
   uint32_t tick_fraction_ = 0;
   bool last_store_failed_ = false;
+  std::array<uint8_t, kProgramCapacity * tmcl::kProgramRecordBytes> program_mirror_{};
+  tmcl::ProgramMemory program_{nvm_, kNvmLayout.program_offset, kProgramCapacity, program_mirror_.data()};
+  // Last: it refers to the members above.
+  tmcl::TmclEngine engine_{*this};
 };
 
 }  // namespace motwin::modules::tmcm1636

@@ -216,8 +216,12 @@ constexpr Row kGlobalRows[] = {
   {{75, "telegram pause time", 0, 255, 0, access("RWAX"), Unit::kMillisecond, "Pause before a serial reply is sent"}, global_field<&GlobalConfig::telegram_pause_ms>()},
   {{76, "serial host address", 1, 255, 2, access("RWAX"), Unit::kAddress, "Host address used in serial replies"}, global_field<&GlobalConfig::serial_host_address>()},
   {{77, "auto start mode", 0, 1, 1, access("RWAX"), Unit::kNone, "1 starts the TMCL program after power-up"}, global_field<&GlobalConfig::auto_start_mode>()},
+  // Not in table 13, but manual 6.4 describes it.
+  {{85, "do not restore user variables", 0, 1, 0, access("RWA"), Unit::kNone, "0 user variables 0..55 restored at power-up, 1 they start at 0"}, global_field<&GlobalConfig::skip_user_variable_restore>()},
   {{128, "application status", 0, 3, 0, access("R"), Unit::kNone, "0 stop, 1 run, 2 step, 3 reset"},
    {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.runtime().application_status); }, nullptr}},
+  {{129, "download mode", 0, 1, 0, access("R"), Unit::kNone, "1 while the module is in download mode (command 132)"},
+   {[](Tmcm1636& m, uint8_t) { return m.runtime().download_mode ? 1 : 0; }, nullptr}},
   {{130, "program counter", 0, kMaxU32, 0, access("R"), Unit::kNone, "TMCL program counter"},
    {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.runtime().program_counter); }, nullptr}},
   {{132, "tick timer", 0, kMaxU32, 0, access("RW"), Unit::kMillisecond, "TMCL tick timer, milliseconds since power-up"},
