@@ -10,5 +10,13 @@ namespace motwin::cli {
 void add_serve_command(CLI::App& app, int& exit_status);
 void add_tmcl_command(CLI::App& app, int& exit_status);
 void add_params_command(CLI::App& app, int& exit_status);
+void add_asm_command(CLI::App& app, int& exit_status);
+void add_disasm_command(CLI::App& app, int& exit_status);
+void add_download_command(CLI::App& app, int& exit_status);
+// start, stop, step, status
+void add_program_control_commands(CLI::App& app, int& exit_status);
+void add_run_command(CLI::App& app, int& exit_status);
+// CANopen: `motwin eds` (docs/canopen.md)
+void add_eds_command(CLI::App& app, int& exit_status);
 
 }  // namespace motwin::cli

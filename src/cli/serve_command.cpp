@@ -5,6 +5,8 @@
 //   motwin: tmcm-1636 (1636V109) eeprom <path|none>
 //   endpoint tmcl-tcp 127.0.0.1:<port>            one per --tmcl-tcp
 //   endpoint tmcl-pty <LINK> </dev/pts/N>         for --tmcl-pty
+//   endpoint can-socketcand 127.0.0.1:<port>      one per --can socketcand:... (CANopen modules)
+//   endpoint can-slcan-tcp 127.0.0.1:<port>       one per --can slcan-tcp:...
 //   ready
 //   output GPO0 1 at <sim seconds>                whenever an output changes
 // Errors before `ready`: one `motwin: error: ...` line on stderr, exit status 2.
@@ -23,12 +25,17 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "host/can_bus.h"
+#include "host/can_endpoint.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
 #include "host/pacing.h"
 #include "host/pty_endpoint.h"
+#include "host/slcan_server.h"
+#include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
+#include "sim/motor_description.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
 
@@ -42,10 +49,13 @@ struct ServeArguments {
   std::string module = "tmcm-1636";
   std::vector<std::string> tcp_endpoints;
   std::string pty_link;
+  std::vector<std::string> can_endpoints;
+  int node_id = 0;
   std::string state_dir;
   std::string speed = "realtime";
   std::vector<std::string> assignments;
   std::string scenario_path;
+  std::string motor = "ideal";
 };
 
 struct ServeError {
@@ -114,6 +124,7 @@ int run_serve(const ServeArguments& arguments) {
   if (!pacing) throw ServeError{error};
 
   host::ModuleOptions options;
+  options.motor = arguments.motor;
   for (const std::string& text : arguments.assignments) {
     const std::optional<sim::SignalAssignment> assignment =
         sim::parse_signal_assignment(descriptor->input_signals(), text, error);
@@ -131,7 +142,14 @@ int run_serve(const ServeArguments& arguments) {
     if (!spec) throw ServeError{"--tmcl-tcp: " + error};
     tcp_specs.push_back(*spec);
   }
-  if (tcp_specs.empty() && arguments.pty_link.empty()) tcp_specs.push_back(host::TcpEndpointSpec{});
+  std::vector<host::CanEndpointSpec> can_specs;
+  for (const std::string& text : arguments.can_endpoints) {
+    const std::optional<host::CanEndpointSpec> spec = host::parse_can_endpoint(text, error);
+    if (!spec) throw ServeError{"--can: " + error};
+    can_specs.push_back(*spec);
+  }
+  options.node_id = static_cast<uint8_t>(arguments.node_id);
+  if (tcp_specs.empty() && arguments.pty_link.empty() && can_specs.empty()) tcp_specs.push_back(host::TcpEndpointSpec{});
 
   if (arguments.state_dir != host::kNoStateDir) {
     if (!arguments.state_dir.empty()) {
@@ -145,6 +163,16 @@ int run_serve(const ServeArguments& arguments) {
   host::MakeModuleResult made = descriptor->make(options);
   if (!made.module) throw ServeError{made.error};
   host::VirtualModule& module = *made.module;
+  if (!module.has_tmcl()) {
+    if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty()) {
+      throw ServeError{std::string(module.name()) + " has no TMCL interface (its firmware speaks CANopen): use --can"};
+    }
+    tcp_specs.clear();
+    if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
+  }
+  if (!can_specs.empty() && module.can_node() == nullptr) {
+    throw ServeError{std::string(module.name()) + " has no CAN interface yet (--can)"};
+  }
 
   host::HostRuntime runtime(module, *pacing);
   if (scenario) runtime.set_scenario(std::move(scenario->events));
@@ -162,6 +190,31 @@ int run_serve(const ServeArguments& arguments) {
         host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), arguments.pty_link);
     if (!opened.endpoint) throw ServeError{opened.error};
     pty = std::move(opened.endpoint);
+  }
+  // The virtual CAN bus, stamped with simulated time; the module leaves it before it goes away.
+  host::CanBus can_bus([&module] { return module.sim_time_us(); });
+  struct BusMembership {
+    host::CanBusNode* node;
+    ~BusMembership() {
+      if (node != nullptr) node->disconnect();
+    }
+  } bus_membership{can_specs.empty() ? nullptr : module.can_node()};
+  if (bus_membership.node != nullptr) bus_membership.node->connect(can_bus);
+  std::vector<std::unique_ptr<host::SocketcandServer>> can_servers;
+  std::vector<std::unique_ptr<host::SlcanTcpServer>> slcan_servers;
+  std::vector<std::string> can_endpoint_lines;
+  for (const host::CanEndpointSpec& spec : can_specs) {
+    if (spec.transport == host::CanTransport::kSlcanTcp) {
+      host::SlcanTcpServer::OpenResult opened = host::SlcanTcpServer::open(runtime.loop(), can_bus, spec.tcp);
+      if (!opened.server) throw ServeError{"--can: " + opened.error};
+      can_endpoint_lines.push_back("endpoint can-slcan-tcp " + opened.server->local_address());
+      slcan_servers.push_back(std::move(opened.server));
+      continue;
+    }
+    host::SocketcandServer::OpenResult opened = host::SocketcandServer::open(runtime.loop(), can_bus, spec.tcp);
+    if (!opened.server) throw ServeError{"--can: " + opened.error};
+    can_endpoint_lines.push_back("endpoint can-socketcand " + opened.server->local_address());
+    can_servers.push_back(std::move(opened.server));
   }
 
   runtime.set_output_listener([](const sim::OutputChange& change) {
@@ -190,6 +243,7 @@ int run_serve(const ServeArguments& arguments) {
              module.nvm_location());
   for (const auto& server : tcp_servers) print_line("endpoint tmcl-tcp " + server->local_address());
   if (pty) print_line("endpoint tmcl-pty " + pty->link_path() + " " + pty->device_path());
+  for (const std::string& line : can_endpoint_lines) print_line(line);
   runtime.start();
   print_line("ready");
 
@@ -198,6 +252,8 @@ int run_serve(const ServeArguments& arguments) {
   runtime.loop().unwatch(shutdown_signals.fd());
   pty.reset();
   tcp_servers.clear();
+  can_servers.clear();
+  slcan_servers.clear();
   return kExitSuccess;
 }
 
@@ -220,6 +276,19 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "Serve TMCL on a pseudo-terminal and make LINK a symbolic link to it (for pyserial and other "
                     "serial-port software; the baud rate, and GP 65, have no effect)")
       ->type_name("LINK");
+  serve->add_option("--can", arguments->can_endpoints,
+                    "Put the module on a virtual CAN bus served as socketcand[:HOST]:PORT (python-can's "
+                    "interface='socketcand') or slcan-tcp:[HOST:]PORT (interface='slcan', "
+                    "channel='socket://HOST:PORT'); port 0 picks a free port. Repeatable: all share one bus. "
+                    "CANopen modules (tmcm-3216) default to socketcand:127.0.0.1:29536. See docs/canopen.md")
+      ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--node-id", arguments->node_id,
+                    "CANopen node ID as the module's address switches would set it (1..127); without it the "
+                    "stored node ID (object 2705, default 1) applies")
+      ->type_name("N")
+      ->check(CLI::Range(1, 127));
   serve->add_option("--state-dir", arguments->state_dir,
                     "Directory of the EEPROM image file <module>.eeprom (default $XDG_DATA_HOME/motwin or "
                     "~/.local/share/motwin); \"none\" keeps the image in memory only")
@@ -234,6 +303,15 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("SIGNAL=VALUE")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  std::string motor_names = "ideal";
+  for (std::string_view preset : sim::motor_preset_names()) motor_names += "|" + std::string(preset);
+  serve->add_option("--motor", arguments->motor,
+                    "Motor behind the power stage: ideal (the axis follows its ramp exactly; fast, the default), "
+                    "a preset (default-24v, large-48v, dc-24v: physical models driven by the firmware's "
+                    "regulators; a new EEPROM image gets the preset's start-up settings) or a motor description "
+                    "file (.json). See docs/tmcm-1636-servo.md")
+      ->type_name(motor_names + "|FILE")
+      ->capture_default_str();
   serve->add_option("--scenario", arguments->scenario_path,
                     "Scenario file: lines \"<time_s> <SIGNAL> <value>\" (sim seconds), # comments")
       ->type_name("FILE");

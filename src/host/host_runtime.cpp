@@ -5,7 +5,9 @@
 namespace motwin::host {
 
 HostRuntime::HostRuntime(VirtualModule& module, Pacing pacing)
-    : module_(module), pacer_(pacing, module.tick_period_us()), service_(module.engine(), loop_) {}
+    : module_(module), pacer_(pacing, module.tick_period_us()) {
+  if (module.has_tmcl()) service_.emplace(module.engine(), loop_);
+}
 
 void HostRuntime::set_scenario(std::vector<sim::ScenarioEvent> events) {
   scenario_.emplace(std::move(events), module_.signals());
@@ -33,7 +35,7 @@ void HostRuntime::advance_ticks(uint64_t ticks) {
   }
   // Events due exactly now apply before any host request at this sim time.
   if (scenario_) scenario_->apply_due(sim_time_us());
-  service_.deliver_events();
+  if (service_) service_->deliver_events();
   report_output_changes();
 }
 
@@ -45,10 +47,10 @@ void HostRuntime::step(uint64_t max_wait_us) {
   const uint64_t now_us = monotonic_now_us();
   const uint64_t wait_us = now_us < busy_poll_until_us_ ? 0 : pacer_.wait_us(now_us, sim_time_us());
   loop_.poll_once(std::min(wait_us, max_wait_us));
-  service_.serve_queued();
+  if (service_) service_->serve_queued();
   report_output_changes();
-  if (service_.served_request_count() != served_requests_seen_) {
-    served_requests_seen_ = service_.served_request_count();
+  if (service_ && service_->served_request_count() != served_requests_seen_) {
+    served_requests_seen_ = service_->served_request_count();
     busy_poll_until_us_ = monotonic_now_us() + kBusyPollAfterRequestUs;
   }
 }

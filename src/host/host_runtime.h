@@ -32,7 +32,9 @@ class HostRuntime {
 
   VirtualModule& module() { return module_; }
   EventLoop& loop() { return loop_; }
-  TmclHostService& service() { return service_; }
+  // Only for a module that has_tmcl(); the TMCM-3216 (CANopen only) has no TMCL service.
+  TmclHostService& service() { return *service_; }
+  bool has_tmcl_service() const { return service_.has_value(); }
   const Pacer& pacer() const { return pacer_; }
 
   // Events are applied to module().signals() at their sim times.
@@ -62,7 +64,7 @@ class HostRuntime {
   VirtualModule& module_;
   Pacer pacer_;
   EventLoop loop_;
-  TmclHostService service_;
+  std::optional<TmclHostService> service_;
   std::optional<sim::ScenarioPlayer> scenario_;
   OutputListener output_listener_;
   std::vector<sim::OutputChange> output_scratch_;

@@ -1,14 +1,17 @@
 #include "host/module_registry.h"
 
 #include "host/tmcm1636_virtual_module.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "host/tmcm3216_virtual_module.h"
+#include "sim/tmcm1636_sim_board.h"
 
 namespace motwin::host {
 namespace {
 
 constexpr ModuleDescriptor kModules[] = {
-    {"tmcm-1636", "TMCM-1636 1-axis BLDC/DC servo module, TMCL firmware 1636V109", &sim::Tmcm1636SimIo::signal_table,
+    {"tmcm-1636", "TMCM-1636 1-axis BLDC/DC servo module, TMCL firmware 1636V109", &sim::Tmcm1636SimBoard::signal_table,
      &Tmcm1636VirtualModule::make},
+    {"tmcm-3216", "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-301 communication area)",
+     &Tmcm3216VirtualModule::signal_table, &Tmcm3216VirtualModule::make},
 };
 
 }  // namespace

@@ -141,12 +141,12 @@ void TmclPtyEndpoint::on_events(short revents) {
 }
 
 void TmclPtyEndpoint::read_some() {
-  if (!service_.has_room(channel_)) return;
-  const size_t room = TmclHostService::kMaxQueuedRequestsPerChannel - service_.queued_requests(channel_);
+  const size_t room = service_.input_room(channel_);
+  if (room == 0) return;
   uint8_t buffer[kReadChunkBytes + 1];
   ssize_t n = 0;
   do {
-    n = ::read(master_fd_, buffer, 1 + std::min(kReadChunkBytes, room * tmcl::kFrameLength));
+    n = ::read(master_fd_, buffer, 1 + std::min(kReadChunkBytes, room));
   } while (n < 0 && errno == EINTR);
   if (n <= 0) {
     if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) on_events(POLLHUP);
@@ -160,14 +160,13 @@ void TmclPtyEndpoint::read_some() {
       output_.clear();
       reported_dropped_output_ = false;
     }
-    if ((status & TIOCPKT_FLUSHWRITE) != 0) decoder_.reset();  // it discarded what it was sending
+    // It discarded what it was sending: a partial frame or line goes too.
+    if ((status & TIOCPKT_FLUSHWRITE) != 0) service_.discard_partial_input(channel_);
     update_poll_events();
     return;
   }
-  const uint64_t now_us = monotonic_now_us();
-  for (ssize_t i = 1; i < n; ++i) {
-    if (decoder_.push(buffer[i], now_us)) service_.submit(channel_, decoder_.frame());
-  }
+  // Frames or ASCII lines, whichever mode the link is in (the echo comes back through send_reply).
+  service_.receive(channel_, buffer + 1, static_cast<size_t>(n - 1), monotonic_now_us());
   update_poll_events();
 }
 

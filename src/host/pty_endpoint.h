@@ -7,7 +7,9 @@
 // whenever no client has the slave open, and a poll() loop would spin on it. The slave is in
 // raw mode; the baud rate a client sets (and GP 65) has no effect on a pty. The master is in
 // packet mode so that a client flushing its input (pyserial does on open) also discards the
-// replies still waiting here: a new client never receives an old client's replies.
+// replies still waiting here: a new client never receives an old client's replies. Frames are
+// decoded with serial timing (5 ms resync gap); command 139 switches the link to ASCII lines
+// (TmclHostService).
 #pragma once
 
 #include <cstddef>
@@ -67,7 +69,6 @@ class TmclPtyEndpoint final : public ReplyChannel {
   std::string device_path_;
   LogSink log_;
   tmcl::ChannelId channel_ = 0;
-  tmcl::SerialFrameDecoder decoder_;  // serial timing: 5 ms resync gap
   std::vector<uint8_t> output_;
   bool input_suspended_ = false;      // after an unexpected hangup, see on_events()
   bool reported_dropped_output_ = false;

@@ -77,8 +77,7 @@ std::string format_socket_address(const sockaddr_storage& address) {
 // One client connection: a frame decoder on the way in, a bounded buffer on the way out.
 class TmclTcpServer::Connection final : public ReplyChannel {
  public:
-  Connection(TmclTcpServer& server, int fd, std::string peer)
-      : server_(server), fd_(fd), peer_(std::move(peer)), decoder_(kResyncGapUs) {}
+  Connection(TmclTcpServer& server, int fd, std::string peer) : server_(server), fd_(fd), peer_(std::move(peer)) {}
   Connection(const Connection&) = delete;
   Connection& operator=(const Connection&) = delete;
   ~Connection() { ::close(fd_); }
@@ -122,10 +121,10 @@ class TmclTcpServer::Connection final : public ReplyChannel {
   bool wants_input() const { return !input_closed_ && server_.service_.has_room(channel_); }
 
   void read_some() {
-    // Read no more frames than the queue takes, so the rest waits in the kernel (back-pressure).
-    const size_t room = TmclHostService::kMaxQueuedRequestsPerChannel - server_.service_.queued_requests(channel_);
+    // Read no more than the service takes, so the rest waits in the kernel (back-pressure).
     uint8_t buffer[kReadChunkBytes];
-    const size_t budget = std::min(sizeof(buffer), room * tmcl::kFrameLength);
+    const size_t budget = std::min(sizeof(buffer), server_.service_.input_room(channel_));
+    if (budget == 0) return;
     ssize_t n = 0;
     do {
       n = ::recv(fd_, buffer, budget, 0);
@@ -138,15 +137,13 @@ class TmclTcpServer::Connection final : public ReplyChannel {
     if (n == 0) {
       // The client is done sending; replies to what it sent still go out before we close.
       input_closed_ = true;
-      decoder_.reset();
       update_poll_events();
       close_if_finished();
       return;
     }
-    const uint64_t now_us = monotonic_now_us();
-    for (ssize_t i = 0; i < n; ++i) {
-      if (decoder_.push(buffer[i], now_us)) server_.service_.submit(channel_, decoder_.frame());
-    }
+    // Frames or ASCII lines, whichever mode this connection is in; the echo of ASCII mode may
+    // come back through send_reply() (and close us if we cannot take it).
+    server_.service_.receive(channel_, buffer, static_cast<size_t>(n), monotonic_now_us());
     update_poll_events();
   }
 
@@ -190,7 +187,6 @@ class TmclTcpServer::Connection final : public ReplyChannel {
   TmclTcpServer& server_;
   int fd_;
   std::string peer_;
-  tmcl::SerialFrameDecoder decoder_;
   tmcl::ChannelId channel_ = 0;
   std::vector<uint8_t> output_;
   size_t output_sent_ = 0;
@@ -300,7 +296,7 @@ void TmclTcpServer::accept_clients(bool after_other_callbacks) {
     const int on = 1;
     ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));  // replies are 9 bytes: no Nagle delay
     auto connection = std::make_shared<Connection>(*this, fd, peer);
-    const tmcl::ChannelId channel = service_.open_channel(*connection);
+    const tmcl::ChannelId channel = service_.open_channel(*connection, kResyncGapUs);
     connection->set_channel(channel);
     connections_[channel] = connection;
     Connection* raw = connection.get();

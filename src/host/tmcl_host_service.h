@@ -1,7 +1,14 @@
-// Serves TMCL frames from every host connection (TCP clients, the pseudo-terminal) to one
-// module, the way a module on a serial bus does: one request at a time, in arrival order,
-// each reply to the connection that asked, the telegram pause (GP 75) before a reply without
-// blocking the loop, and the delayed replies of command 138 to the connection that asked.
+// Serves TMCL from every host connection (TCP clients, the pseudo-terminal) to one module, the
+// way a module on a serial bus does: one request at a time, in arrival order, each reply to the
+// connection that asked, the telegram pause (GP 75) before a reply without blocking the loop,
+// and the delayed replies of command 138 to the connection that asked.
+//
+// Each connection is a link of its own, in binary mode (9-byte frames) or ASCII mode (text
+// lines, core/tmcl/ascii_link.h): command 139 switches it to ASCII once its binary reply is
+// out, the line BIN back to binary once its reply is out. Bytes that arrive while such a switch
+// may be pending (after a 139 frame, after each ASCII line until it is answered) wait here and
+// are read in the mode that follows. Every connection starts in the mode GP 67 bit 0 says, and
+// returns to it whenever the module powers up (255, 137).
 #pragma once
 
 #include <cstddef>
@@ -12,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/tmcl/ascii_link.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
 #include "host/event_loop.h"
@@ -32,27 +40,43 @@ class ReplyChannel {
   ~ReplyChannel() = default;
 };
 
+enum class LinkMode : uint8_t { kBinary, kAscii };
+
 class TmclHostService final : public tmcl::ReplySink {
  public:
   // A connection with this many requests waiting stops being read until some are served, so
   // that a client flooding frames gets TCP back-pressure instead of growing our memory.
   static constexpr size_t kMaxQueuedRequestsPerChannel = 32;
+  // Received bytes not yet read as frames or lines (waiting for a reply that may switch the
+  // link's mode); a connection with this many is not read until they are.
+  static constexpr size_t kMaxPendingInputBytes = 4096;
 
   TmclHostService(tmcl::TmclEngine& engine, EventLoop& loop);
   TmclHostService(const TmclHostService&) = delete;
   TmclHostService& operator=(const TmclHostService&) = delete;
   ~TmclHostService();
 
-  // Never returns 0 (channel 0 is what the engine uses for a stored program).
-  tmcl::ChannelId open_channel(ReplyChannel& channel);
+  // Never returns 0 (channel 0 is what the engine uses for a stored program). `resync_gap_us`:
+  // a pause this long between two bytes discards a partial binary frame.
+  tmcl::ChannelId open_channel(ReplyChannel& channel,
+                               uint32_t resync_gap_us = tmcl::SerialFrameDecoder::kDefaultResyncGapUs);
   // Requests already queued from this channel still run (their bytes arrived, as on a serial
   // line); their replies and any pending command 138 events of the channel are dropped.
   void close_channel(tmcl::ChannelId id);
   bool is_open(tmcl::ChannelId id) const { return channels_.count(id) != 0; }
 
-  void submit(tmcl::ChannelId id, const tmcl::Frame& frame);
+  // Bytes a connection received, in arrival order; at most input_room(id) of them. Complete
+  // frames and lines become requests; the echo of ASCII mode goes out at once.
+  void receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us);
+  // How many bytes the connection may hand to receive() now; 0: stop reading (back-pressure).
+  size_t input_room(tmcl::ChannelId id) const;
+  bool has_room(tmcl::ChannelId id) const { return input_room(id) > 0; }
+  // The host discarded what it was sending (a pty client flushed its output): a partial frame
+  // or line is dropped.
+  void discard_partial_input(tmcl::ChannelId id);
+  std::optional<LinkMode> link_mode(tmcl::ChannelId id) const;
+
   size_t queued_requests(tmcl::ChannelId id) const;
-  bool has_room(tmcl::ChannelId id) const { return queued_requests(id) < kMaxQueuedRequestsPerChannel; }
   size_t total_queued_requests() const { return queue_.size(); }
 
   // Serves queued requests in arrival order until the queue is empty or a reply is being held
@@ -69,31 +93,62 @@ class TmclHostService final : public tmcl::ReplySink {
   void deliver(tmcl::ChannelId channel, const tmcl::Reply& reply) override;
 
  private:
+  struct PendingByte {
+    uint8_t byte;
+    uint64_t arrival_us;  // for the resynchronisation gap of binary framing
+  };
+  struct Channel {
+    ReplyChannel* sink = nullptr;
+    LinkMode mode = LinkMode::kBinary;
+    tmcl::SerialFrameDecoder decoder;
+    tmcl::AsciiLink ascii;
+    std::deque<PendingByte> input;
+    // A 139 frame or an ASCII line is queued or being answered: its reply may switch the mode,
+    // so the bytes after it wait in `input`.
+    bool awaiting_reply = false;
+  };
   struct QueuedRequest {
     tmcl::ChannelId channel;
+    bool ascii;                 // which of the two below
     tmcl::Frame frame;
+    tmcl::AsciiCommand command;
+  };
+  // A reply ready to go, and what follows once it is sent.
+  struct Outgoing {
+    std::vector<uint8_t> bytes;
+    bool reset_after_send = false;
+    std::optional<LinkMode> mode_after;
   };
   struct HeldReply {
     tmcl::ChannelId channel;
-    tmcl::Frame bytes;
-    uint8_t length;
-    bool reset_after_send;
-    std::vector<tmcl::Frame> events_after;  // command 138 replies that must not overtake it
+    Outgoing reply;
+    std::vector<std::vector<uint8_t>> events_after;  // command 138 replies that must not overtake it
     EventLoop::TimerId timer;
   };
 
+  void enqueue(tmcl::ChannelId id, QueuedRequest request);
+  // Reads the channel's waiting input as frames or lines until it runs out, a reply must be
+  // awaited, or the request queue is full.
+  void process_input(tmcl::ChannelId id);
   void send_to(tmcl::ChannelId channel, const uint8_t* bytes, size_t length);
+  void complete(tmcl::ChannelId channel, const Outgoing& reply);
   void release_held_reply();
   void finish_request(tmcl::ChannelId channel);
+  void set_mode(Channel& channel, LinkMode mode);
+  // After a power-up every link returns to its start mode (GP 67 bit 0).
+  void follow_power_ups();
+  LinkMode start_mode() const;
+  std::vector<uint8_t> encode_event(LinkMode mode, const tmcl::Reply& reply) const;
 
   tmcl::TmclEngine& engine_;
   EventLoop& loop_;
-  std::map<tmcl::ChannelId, ReplyChannel*> channels_;
+  std::map<tmcl::ChannelId, Channel> channels_;
   std::map<tmcl::ChannelId, size_t> queued_per_channel_;
   std::deque<QueuedRequest> queue_;
   std::optional<HeldReply> held_;
   tmcl::ChannelId next_channel_id_ = 1;
   uint64_t served_request_count_ = 0;
+  uint32_t power_ups_seen_ = 0;
   bool serving_ = false;
 };
 

@@ -11,6 +11,7 @@
 #include "host/eeprom_file.h"
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
+#include "sim/tmcm1636_sim_board.h"
 #include "sim/tmcm1636_sim_io.h"
 
 namespace motwin::host {
@@ -35,15 +36,18 @@ class Tmcm1636VirtualModule final : public VirtualModule {
   uint64_t tick_count() const override { return tick_count_; }
   board::NonVolatileMemory& nvm() override { return *nvm_; }
   std::string nvm_location() const override;
-  sim::SignalBoard& signals() override { return io_; }
+  sim::SignalBoard& signals() override { return *board_; }
 
   Device& device() { return *device_; }
   sim::Tmcm1636SimIo& io() { return io_; }
+  // The I/O plus, unless the motor is ideal, the motor plant.
+  sim::Tmcm1636SimBoard& board() { return *board_; }
 
  private:
   Tmcm1636VirtualModule() = default;
 
   sim::Tmcm1636SimIo io_;
+  std::unique_ptr<sim::Tmcm1636SimBoard> board_;
   std::unique_ptr<EepromFile> eeprom_file_;
   std::unique_ptr<MemoryImage> memory_image_;
   board::NonVolatileMemory* nvm_ = nullptr;

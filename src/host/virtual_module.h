@@ -14,13 +14,20 @@
 
 namespace motwin::host {
 
+class CanBusNode;
+
 class VirtualModule {
  public:
   virtual ~VirtualModule() = default;
 
   virtual std::string_view name() const = 0;              // "tmcm-1636"
   virtual std::string_view firmware_version() const = 0;  // "1636V109"
+  // Only called when has_tmcl(): a module whose firmware speaks no TMCL (the TMCM-3216 CANopen
+  // firmware) gets no TMCL service and no TMCL endpoints.
   virtual tmcl::TmclEngine& engine() = 0;
+  virtual bool has_tmcl() const { return true; }
+  // The module's CAN controller as a node of a virtual bus (host/can_bus.h); nullptr: none.
+  virtual CanBusNode* can_node() { return nullptr; }
 
   // Fixed simulation step of the module (TMCM-1636: 50 µs).
   virtual uint32_t tick_period_us() const = 0;

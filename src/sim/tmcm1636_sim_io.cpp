@@ -91,6 +91,10 @@ void Tmcm1636SimIo::set_temperature_celsius(double celsius) {
   temperature_raw_ = hw::temperature_adc_from_celsius(celsius);
 }
 
+void Tmcm1636SimIo::set_measured_temperature_celsius(double celsius) {
+  temperature_raw_ = hw::temperature_adc_from_celsius(celsius);
+}
+
 void Tmcm1636SimIo::set_reference_switch_level(ReferenceSwitch which, bool level) {
   const auto index = static_cast<size_t>(which);
   if (index < reference_switch_levels_.size()) reference_switch_levels_[index] = level;

@@ -43,6 +43,11 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public SignalBoard {
   void set_temperature_celsius(double celsius);
   double temperature_celsius() const { return temperature_celsius_; }
   void set_reference_switch_level(board::ReferenceSwitch which, bool level);
+  // With a physical motor the board measures its own bus and heat sink: ADC_VM and ADC_TEMP
+  // then read these, while VSUPPLY and TEMP stay the source voltage and the ambient
+  // temperature that the signals set (sim/tmcm1636_sim_board.h).
+  void set_measured_supply_raw(uint16_t raw) { supply_raw_ = raw; }
+  void set_measured_temperature_celsius(double celsius);
 
   // Simulated time used to stamp output changes; the host module wrapper sets it per tick.
   void set_sim_time_us(uint64_t sim_time_us) { sim_time_us_ = sim_time_us; }

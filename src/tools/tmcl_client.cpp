@@ -116,7 +116,11 @@ Result<TmclReply> decode_reply(const Frame& bytes, const Instruction& request) {
   // Replies keep the value where requests have it (bytes 4..7, big-endian).
   reply.value = tmcl::decode_instruction(bytes).value;
   const bool is_checksum_error_reply = reply.status == tmcl::to_byte(tmcl::Status::kChecksumError);
-  if (!is_checksum_error_reply && reply.command != request.command) {
+  // 134 (type 0) answers with the stored instruction's opcode in the command byte
+  // (docs/assembler.md, "Reading program memory back").
+  const bool carries_stored_opcode = request.command == tmcl::command::kReadProgramMemory &&
+                                     reply.status == tmcl::to_byte(tmcl::Status::kOk);
+  if (!is_checksum_error_reply && !carries_stored_opcode && reply.command != request.command) {
     return Error{fmt::format("reply is for command {}, not for the request's command {} (reply {})", reply.command,
                              request.command, hex_bytes(bytes.data(), kFrameLength))};
   }

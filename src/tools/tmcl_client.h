@@ -41,7 +41,8 @@ struct TmclReply {
 ReplyKind expected_reply_kind(const tmcl::Instruction& request);
 
 // Checks and decodes the reply bytes to `request`: checksum, and that a normal reply answers
-// the request's command (a checksum-error reply, status 1, carries command 0).
+// the request's command (a checksum-error reply, status 1, carries command 0; a successful
+// reply to 134 carries the opcode of the instruction read from program memory).
 Result<TmclReply> decode_reply(const tmcl::Frame& bytes, const tmcl::Instruction& request);
 
 // "02 01 64 06 00 00 00 2A 91".

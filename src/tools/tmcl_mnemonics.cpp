@@ -5,6 +5,8 @@
 #include <cctype>
 #include <charconv>
 #include <limits>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include <fmt/format.h>
@@ -17,114 +19,29 @@ namespace {
 using tmcl::Instruction;
 namespace cmd = tmcl::command;
 
-// --- Symbolic operand names (TMCM-1636 manual 2.6, notes/tmcl.md "Code tables") -----------
-
-constexpr Symbol kMoveTypes[] = {{"ABS", 0}, {"REL", 1}, {"COORD", 2}};
-constexpr Symbol kCalcOperations[] = {{"ADD", 0}, {"SUB", 1}, {"MUL", 2}, {"DIV", 3}, {"MOD", 4},
-                                      {"AND", 5}, {"OR", 6},  {"XOR", 7}, {"NOT", 8}, {"LOAD", 9}};
-constexpr Symbol kCalcxOperations[] = {{"ADD", 0}, {"SUB", 1}, {"MUL", 2}, {"DIV", 3},  {"MOD", 4}, {"AND", 5},
-                                       {"OR", 6},  {"XOR", 7}, {"NOT", 8}, {"LOAD", 9}, {"SWAP", 10}};
-constexpr Symbol kJumpConditions[] = {{"ZE", 0}, {"NZ", 1},  {"EQ", 2},   {"NE", 3},   {"GT", 4},
-                                      {"GE", 5}, {"LT", 6},  {"LE", 7},   {"ETO", 8},  {"EAL", 9},
-                                      {"EDV", 10}, {"EPO", 11}, {"ESD", 12}};
-constexpr Symbol kWaitConditions[] = {{"TICKS", 0}, {"POS", 1}, {"REFSW", 2}, {"LIMSW", 3}, {"RFS", 4}};
-constexpr Symbol kErrorFlags[] = {{"ALL", 0}, {"ETO", 1}, {"EAL", 2}, {"EDV", 3}, {"EPO", 4}, {"ESD", 5}};
-constexpr Symbol kReferenceSearchActions[] = {{"START", 0}, {"STOP", 1}, {"STATUS", 2}};
-
-// --- Operand layouts -----------------------------------------------------------------------
-
-constexpr OperandSpec kMotorVelocity[] = {{"motor", Field::kMotorBank}, {"velocity", Field::kValue}};
-constexpr OperandSpec kMotor[] = {{"motor", Field::kMotorBank}};
-constexpr OperandSpec kMoveTypeMotorValue[] = {
-    {"type", Field::kType, kMoveTypes}, {"motor", Field::kMotorBank}, {"value", Field::kValue}};
-constexpr OperandSpec kParamMotorValue[] = {
-    {"param", Field::kType}, {"motor", Field::kMotorBank}, {"value", Field::kValue}};
-constexpr OperandSpec kParamMotor[] = {{"param", Field::kType}, {"motor", Field::kMotorBank}};
-constexpr OperandSpec kParamBankValue[] = {
-    {"param", Field::kType}, {"bank", Field::kMotorBank}, {"value", Field::kValue}};
-constexpr OperandSpec kParamBank[] = {{"param", Field::kType}, {"bank", Field::kMotorBank}};
-constexpr OperandSpec kReferenceSearch[] = {{"action", Field::kType, kReferenceSearchActions},
-                                            {"motor", Field::kMotorBank}};
-constexpr OperandSpec kPortBankValue[] = {{"port", Field::kType}, {"bank", Field::kMotorBank}, {"value", Field::kValue}};
-constexpr OperandSpec kPortBank[] = {{"port", Field::kType}, {"bank", Field::kMotorBank}};
-constexpr OperandSpec kCalc[] = {{"operation", Field::kType, kCalcOperations}, {"operand", Field::kValue}};
-constexpr OperandSpec kCompare[] = {{"operand", Field::kValue}};
-constexpr OperandSpec kJumpConditional[] = {{"condition", Field::kType, kJumpConditions}, {"address", Field::kValue}};
-constexpr OperandSpec kAddress[] = {{"address", Field::kValue}};
-constexpr OperandSpec kInterrupt[] = {{"interrupt", Field::kType}};
-constexpr OperandSpec kWait[] = {
-    {"condition", Field::kType, kWaitConditions}, {"motor", Field::kMotorBank}, {"ticks", Field::kValue}};
-constexpr OperandSpec kCoordinateMotorPosition[] = {
-    {"coordinate", Field::kType}, {"motor", Field::kMotorBank}, {"position", Field::kValue}};
-constexpr OperandSpec kCoordinateMotor[] = {{"coordinate", Field::kType}, {"motor", Field::kMotorBank}};
-constexpr OperandSpec kCalcx[] = {{"operation", Field::kType, kCalcxOperations}};
-constexpr OperandSpec kClearErrorFlag[] = {{"flag", Field::kType, kErrorFlags}};
-constexpr OperandSpec kVector[] = {{"interrupt", Field::kType}, {"address", Field::kValue}};
-
-constexpr std::span<const OperandSpec> kNone{};
-
-// --- The mnemonics, by command number (manual table 4; notes/tmcl.md for 13, 25, 26, 30-32,
-// 37-39) -------------------------------------------------------------------------------------
-
-constexpr MnemonicSpec kMnemonics[] = {
-    {"ROR", cmd::kRor, kMotorVelocity},
-    {"ROL", cmd::kRol, kMotorVelocity},
-    {"MST", cmd::kMst, kMotor},
-    {"MVP", cmd::kMvp, kMoveTypeMotorValue},
-    {"SAP", cmd::kSap, kParamMotorValue},
-    {"GAP", cmd::kGap, kParamMotor},
-    {"STAP", cmd::kStap, kParamMotor},
-    {"RSAP", cmd::kRsap, kParamMotor},
-    {"SGP", cmd::kSgp, kParamBankValue},
-    {"GGP", cmd::kGgp, kParamBank},
-    {"STGP", cmd::kStgp, kParamBank},
-    {"RSGP", cmd::kRsgp, kParamBank},
-    {"RFS", cmd::kRfs, kReferenceSearch},
-    {"SIO", cmd::kSio, kPortBankValue},
-    {"GIO", cmd::kGio, kPortBank},
-    {"CALC", cmd::kCalc, kCalc},
-    {"COMP", cmd::kComp, kCompare},
-    {"JC", cmd::kJc, kJumpConditional},
-    {"JA", cmd::kJa, kAddress},
-    {"CSUB", cmd::kCsub, kAddress},
-    {"RSUB", cmd::kRsub, kNone},
-    {"EI", cmd::kEi, kInterrupt},
-    {"DI", cmd::kDi, kInterrupt},
-    {"WAIT", cmd::kWait, kWait},
-    {"STOP", cmd::kStop, kNone},
-    {"SCO", cmd::kSco, kCoordinateMotorPosition},
-    {"GCO", cmd::kGco, kCoordinateMotor},
-    {"CCO", cmd::kCco, kCoordinateMotor},
-    {"CALCX", cmd::kCalcx, kCalcx},
-    {"AAP", cmd::kAap, kParamMotor},
-    {"AGP", cmd::kAgp, kParamBank},
-    {"CLE", cmd::kCle, kClearErrorFlag},
-    {"VECT", cmd::kVect, kVector},
-    {"RETI", cmd::kReti, kNone},
-    {"ACO", cmd::kAco, kCoordinateMotor},
-};
-
-constexpr bool table_is_consistent() {
-  for (size_t i = 0; i < std::size(kMnemonics); ++i) {
-    if (i > 0 && kMnemonics[i - 1].command >= kMnemonics[i].command) return false;
-    if (kMnemonics[i].operands.size() > 3) return false;
-    // Each field at most once per mnemonic.
-    int used[3] = {0, 0, 0};
-    for (const OperandSpec& operand : kMnemonics[i].operands) {
-      if (++used[static_cast<int>(operand.field)] > 1) return false;
-    }
-  }
-  return true;
-}
-static_assert(table_is_consistent(), "mnemonic table: sorted by command, at most one operand per field");
+// The table is core data (core/tmcl/mnemonic_table.h), shared with the firmware's ASCII interface.
+constexpr std::span<const MnemonicSpec> kMnemonics{tmcl::kMnemonicTable};
 
 // --- Text helpers ----------------------------------------------------------------------------
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
-// Splits "MVP ABS, 0, 90000" into words; commas are optional separators, but an empty operand
-// ("GAP 52,,0" or a trailing comma) is an error rather than a silent 0.
-Result<std::vector<std::string_view>> split_words(std::string_view text) {
+// A parse error with the kind and position that ParseErrorDetail reports.
+struct Failure {
+  std::string message;
+  ParseErrorKind kind = ParseErrorKind::kSyntax;
+  size_t offset = 0;
+  size_t length = 0;
+};
+
+// Where `word` (a view into `text`) starts in `text`.
+size_t offset_in(std::string_view text, std::string_view word) {
+  return static_cast<size_t>(word.data() - text.data());
+}
+
+// Splits "MVP ABS, 0, 90000" into words (views into `text`); commas are optional separators,
+// but an empty operand ("GAP 52,,0" or a trailing comma) is an error rather than a silent 0.
+std::variant<std::vector<std::string_view>, Failure> split_words(std::string_view text) {
   if (const size_t comment = text.find("//"); comment != std::string_view::npos) text = text.substr(0, comment);
   std::vector<std::string_view> words;
   bool comma_pending = false;
@@ -134,8 +51,12 @@ Result<std::vector<std::string_view>> split_words(std::string_view text) {
     if (is_blank(c)) {
       ++i;
     } else if (c == ',') {
-      if (words.empty()) return Error{"expected a mnemonic or a command number before ','"};
-      if (comma_pending) return Error{fmt::format("empty operand after '{}'", words.back())};
+      if (words.empty()) {
+        return Failure{"expected a mnemonic or a command number before ','", ParseErrorKind::kSyntax, i, 1};
+      }
+      if (comma_pending) {
+        return Failure{fmt::format("empty operand after '{}'", words.back()), ParseErrorKind::kSyntax, i, 1};
+      }
       comma_pending = true;
       ++i;
     } else {
@@ -145,7 +66,9 @@ Result<std::vector<std::string_view>> split_words(std::string_view text) {
       comma_pending = false;
     }
   }
-  if (comma_pending) return Error{fmt::format("empty operand after '{}'", words.back())};
+  if (comma_pending) {
+    return Failure{fmt::format("empty operand after '{}'", words.back()), ParseErrorKind::kSyntax, text.size(), 0};
+  }
   return words;
 }
 
@@ -172,9 +95,10 @@ constexpr int64_t kValueMin = std::numeric_limits<int32_t>::min();
 constexpr int64_t kValueMax = std::numeric_limits<uint32_t>::max();
 
 // One operand word to a field value: a number, one of the operand's symbols, or an identifier
-// the caller resolves. `what` names the operand in error messages.
-Result<int64_t> operand_value(std::string_view word, std::span<const Symbol> symbols, const ParseOptions& options,
-                              std::string_view what) {
+// the caller resolves. `what` names the operand in error messages. Failure offsets are
+// relative to `word`.
+std::variant<int64_t, Failure> operand_value(std::string_view word, std::span<const Symbol> symbols,
+                                             const ParseOptions& options, std::string_view what) {
   if (const std::optional<int64_t> number = parse_integer(word)) return *number;
   if (const std::optional<uint8_t> code = find_symbol(symbols, word)) return static_cast<int64_t>(*code);
   if (options.resolve_identifier) {
@@ -182,28 +106,37 @@ Result<int64_t> operand_value(std::string_view word, std::span<const Symbol> sym
   }
   const char first = word.front();
   if (std::isdigit(static_cast<unsigned char>(first)) || first == '-' || first == '+') {
-    return Error{fmt::format("{}: '{}' is not a number (decimal or 0x hexadecimal, at most 64 bits)", what, word)};
+    return Failure{fmt::format("{}: '{}' is not a number (decimal or 0x hexadecimal, at most 64 bits)", what, word),
+                   ParseErrorKind::kSyntax, 0, word.size()};
+  }
+  const std::string alternatives = symbols.empty() ? "" : symbol_alternatives(symbols, ", ") + ", ";
+  if (options.resolve_identifier) {
+    return Failure{fmt::format("{}: undefined label or constant '{}', expected {}a number, a label or a constant",
+                               what, word, alternatives),
+                   ParseErrorKind::kUnknownIdentifier, 0, word.size()};
   }
   if (!symbols.empty()) {
-    return Error{fmt::format("{}: unknown symbol '{}', expected {} or a number", what, word,
-                             symbol_alternatives(symbols, ", "))};
+    return Failure{fmt::format("{}: unknown symbol '{}', expected {} or a number", what, word,
+                               symbol_alternatives(symbols, ", ")),
+                   ParseErrorKind::kUnknownIdentifier, 0, word.size()};
   }
-  return Error{fmt::format("{}: unknown symbol '{}', expected a number", what, word)};
+  return Failure{fmt::format("{}: unknown symbol '{}', expected a number", what, word),
+                 ParseErrorKind::kUnknownIdentifier, 0, word.size()};
 }
 
 // Range check and store into the instruction field.
-std::optional<Error> store_field(Instruction& instruction, Field field, int64_t value, std::string_view what) {
+std::optional<std::string> store_field(Instruction& instruction, Field field, int64_t value, std::string_view what) {
   if (field == Field::kValue) {
     if (value < kValueMin || value > kValueMax) {
-      return Error{fmt::format("{}: {} is out of range for the 32-bit value field ({}..{})", what, value, kValueMin,
-                               kValueMax)};
+      return fmt::format("{}: {} is out of range for the 32-bit value field ({}..{})", what, value, kValueMin,
+                         kValueMax);
     }
     instruction.value = static_cast<int32_t>(static_cast<uint32_t>(value));
     return std::nullopt;
   }
   if (value < 0 || value > kByteMax) {
-    return Error{fmt::format("{}: {} is out of range for the byte field {} (0..{})", what, value,
-                             field_description(field), kByteMax)};
+    return fmt::format("{}: {} is out of range for the byte field {} (0..{})", what, value, field_description(field),
+                       kByteMax);
   }
   if (field == Field::kType) {
     instruction.type = static_cast<uint8_t>(value);
@@ -213,33 +146,102 @@ std::optional<Error> store_field(Instruction& instruction, Field field, int64_t 
   return std::nullopt;
 }
 
+// Evaluates `word` (a view into `text`) and stores it; failures point at the word.
+std::optional<Failure> evaluate_and_store(std::string_view text, std::string_view word, std::span<const Symbol> symbols,
+                                          const ParseOptions& options, std::string_view what,
+                                          const std::function<std::optional<std::string>(int64_t)>& store) {
+  std::variant<int64_t, Failure> value = operand_value(word, symbols, options, what);
+  if (Failure* failure = std::get_if<Failure>(&value)) {
+    failure->offset += offset_in(text, word);
+    return std::move(*failure);
+  }
+  if (std::optional<std::string> message = store(std::get<int64_t>(value))) {
+    return Failure{std::move(*message), ParseErrorKind::kOutOfRange, offset_in(text, word), word.size()};
+  }
+  return std::nullopt;
+}
+
 // "CMD [TYPE [MOTOR [VALUE]]]": the form for control commands, which have no mnemonic.
-Result<Instruction> parse_numeric_form(std::span<const std::string_view> words, const ParseOptions& options) {
+std::variant<Instruction, Failure> parse_numeric_form(std::string_view text, std::span<const std::string_view> words,
+                                                      const ParseOptions& options) {
   static constexpr std::string_view kNames[] = {"command number", "type", "motor/bank", "value"};
   static constexpr Field kFields[] = {Field::kType, Field::kMotorBank, Field::kValue};
   if (words.size() > std::size(kNames)) {
-    return Error{fmt::format("the numeric form takes at most 4 numbers (CMD TYPE MOTOR VALUE), got {}", words.size())};
+    return Failure{
+        fmt::format("the numeric form takes at most 4 numbers (CMD TYPE MOTOR VALUE), got {}", words.size()),
+        ParseErrorKind::kOperandCount, offset_in(text, words[std::size(kNames)]), words[std::size(kNames)].size()};
   }
   Instruction instruction;
   for (size_t i = 0; i < words.size(); ++i) {
-    Result<int64_t> value = operand_value(words[i], {}, options, kNames[i]);
-    if (!value) return Error{value.error()};
+    std::optional<Failure> failure;
     if (i == 0) {
-      if (value.value() < 0 || value.value() > kByteMax) {
-        return Error{fmt::format("command number {} is out of range (0..{})", value.value(), kByteMax)};
-      }
-      instruction.command = static_cast<uint8_t>(value.value());
-      continue;
+      const auto store_command = [&](int64_t value) -> std::optional<std::string> {
+        if (value < 0 || value > kByteMax) {
+          return fmt::format("command number {} is out of range (0..{})", value, kByteMax);
+        }
+        instruction.command = static_cast<uint8_t>(value);
+        return std::nullopt;
+      };
+      failure = evaluate_and_store(text, words[i], {}, options, kNames[i], store_command);
+    } else {
+      failure = evaluate_and_store(text, words[i], {}, options, kNames[i], [&](int64_t value) {
+        return store_field(instruction, kFields[i - 1], value, kNames[i]);
+      });
     }
-    if (std::optional<Error> error = store_field(instruction, kFields[i - 1], value.value(), kNames[i])) {
-      return *error;
-    }
+    if (failure) return std::move(*failure);
   }
   return instruction;
 }
 
 std::string operand_label(const OperandSpec& operand) {
   return operand.symbols.empty() ? std::string(operand.name) : symbol_alternatives(operand.symbols, "|");
+}
+
+std::variant<Instruction, Failure> parse(std::string_view text, const ParseOptions& options) {
+  std::variant<std::vector<std::string_view>, Failure> split = split_words(text);
+  if (Failure* failure = std::get_if<Failure>(&split)) return std::move(*failure);
+  const std::vector<std::string_view>& words = std::get<std::vector<std::string_view>>(split);
+  if (words.empty()) {
+    return Failure{"empty instruction: expected a mnemonic (such as MVP, SAP, GAP) or a command number",
+                   ParseErrorKind::kSyntax, 0, 0};
+  }
+
+  const std::string_view head = words.front();
+  if (parse_integer(head)) return parse_numeric_form(text, words, options);
+
+  const MnemonicSpec* spec = find_mnemonic(head);
+  if (spec == nullptr) {
+    return Failure{fmt::format("unknown mnemonic '{}': expected a TMCL mnemonic (such as MVP, SAP, GAP) or a "
+                               "command number",
+                               head),
+                   ParseErrorKind::kUnknownMnemonic, offset_in(text, head), head.size()};
+  }
+  const std::span<const std::string_view> operands{words.begin() + 1, words.end()};
+  if (operands.size() != spec->operands.size()) {
+    // Point at the first surplus operand, or at the end of the text for a missing one.
+    const bool too_many = operands.size() > spec->operands.size();
+    const size_t offset = too_many ? offset_in(text, operands[spec->operands.size()])
+                                   : offset_in(text, words.back()) + words.back().size();
+    const size_t length = too_many ? operands[spec->operands.size()].size() : 0;
+    if (spec->operands.empty()) {
+      return Failure{fmt::format("{} takes no operands, got {}", spec->mnemonic, operands.size()),
+                     ParseErrorKind::kOperandCount, offset, length};
+    }
+    return Failure{fmt::format("{} takes {} operand{} ({}), got {}", spec->mnemonic, spec->operands.size(),
+                               spec->operands.size() == 1 ? "" : "s", operand_synopsis(*spec), operands.size()),
+                   ParseErrorKind::kOperandCount, offset, length};
+  }
+  Instruction instruction;
+  instruction.command = spec->command;
+  for (size_t i = 0; i < operands.size(); ++i) {
+    const OperandSpec& operand = spec->operands[i];
+    const std::string what = fmt::format("{} operand {} ({})", spec->mnemonic, i + 1, operand_label(operand));
+    std::optional<Failure> failure =
+        evaluate_and_store(text, operands[i], operand.symbols, options, what,
+                           [&](int64_t value) { return store_field(instruction, operand.field, value, what); });
+    if (failure) return std::move(*failure);
+  }
+  return instruction;
 }
 
 }  // namespace
@@ -297,38 +299,12 @@ std::optional<int64_t> parse_integer(std::string_view text) {
 }
 
 Result<Instruction> parse_instruction(std::string_view text, const ParseOptions& options) {
-  Result<std::vector<std::string_view>> split = split_words(text);
-  if (!split) return Error{split.error()};
-  const std::vector<std::string_view>& words = split.value();
-  if (words.empty()) return Error{"empty instruction: expected a mnemonic (such as MVP, SAP, GAP) or a command number"};
-
-  const std::string_view head = words.front();
-  if (parse_integer(head)) return parse_numeric_form(words, options);
-
-  const MnemonicSpec* spec = find_mnemonic(head);
-  if (spec == nullptr) {
-    return Error{fmt::format("unknown mnemonic '{}': expected a TMCL mnemonic (such as MVP, SAP, GAP) or a "
-                             "command number",
-                             head)};
+  std::variant<Instruction, Failure> parsed = parse(text, options);
+  if (Failure* failure = std::get_if<Failure>(&parsed)) {
+    if (options.error_detail != nullptr) *options.error_detail = {failure->kind, failure->offset, failure->length};
+    return Error{std::move(failure->message)};
   }
-  const std::span<const std::string_view> operands{words.begin() + 1, words.end()};
-  if (operands.size() != spec->operands.size()) {
-    if (spec->operands.empty()) {
-      return Error{fmt::format("{} takes no operands, got {}", spec->mnemonic, operands.size())};
-    }
-    return Error{fmt::format("{} takes {} operand{} ({}), got {}", spec->mnemonic, spec->operands.size(),
-                             spec->operands.size() == 1 ? "" : "s", operand_synopsis(*spec), operands.size())};
-  }
-  Instruction instruction;
-  instruction.command = spec->command;
-  for (size_t i = 0; i < operands.size(); ++i) {
-    const OperandSpec& operand = spec->operands[i];
-    const std::string what = fmt::format("{} operand {} ({})", spec->mnemonic, i + 1, operand_label(operand));
-    Result<int64_t> value = operand_value(operands[i], operand.symbols, options, what);
-    if (!value) return Error{value.error()};
-    if (std::optional<Error> error = store_field(instruction, operand.field, value.value(), what)) return *error;
-  }
-  return instruction;
+  return std::get<Instruction>(parsed);
 }
 
 std::string format_instruction(const Instruction& instruction) {

@@ -1,7 +1,8 @@
-// TMCL instructions as TMCL-IDE writes them ("MVP ABS, 0, 90000"): one declarative table of
+// TMCL instructions as TMCL-IDE writes them ("MVP ABS, 0, 90000"): the declarative table of
 // mnemonics, command numbers, operand layouts and symbolic operand names (TMCM-1636 manual
-// chapter 2, notes/tmcl.md), and a parser from one line of text to an Instruction. The table is
-// shared by the `motwin tmcl` client and the TMCL assembler.
+// chapter 2, notes/tmcl.md; the data lives in core/tmcl/mnemonic_table.h, shared with the
+// firmware's ASCII interface), and a parser from one line of text to an Instruction. Used by the
+// `motwin tmcl` client, the TMCL assembler and the disassembler.
 #pragma once
 
 #include <cstdint>
@@ -12,31 +13,17 @@
 #include <string_view>
 
 #include "core/tmcl/instruction.h"
+#include "core/tmcl/mnemonic_table.h"
 #include "tools/result.h"
 
 namespace motwin::tools {
 
-// The instruction field an operand is encoded into.
-enum class Field : uint8_t { kType, kMotorBank, kValue };
-
-// A symbolic operand such as ABS (MVP type 0) or GE (JC type 5).
-struct Symbol {
-  std::string_view name;
-  uint8_t code;
-};
-
-struct OperandSpec {
-  std::string_view name;  // as the manual names it: "motor", "velocity", "param" ...
-  Field field;
-  // Names this operand may be written as; a number is accepted as well. Empty: numbers only.
-  std::span<const Symbol> symbols = {};
-};
-
-struct MnemonicSpec {
-  std::string_view mnemonic;  // upper case
-  uint8_t command;
-  std::span<const OperandSpec> operands;  // in source order; fields not listed are 0
-};
+// The table itself is core data (core/tmcl/mnemonic_table.h), shared with the ASCII interface
+// of the firmware; these are its types under their tool names.
+using Field = tmcl::OperandField;      // kType, kMotorBank, kValue
+using Symbol = tmcl::OperandSymbol;    // a symbolic operand such as ABS (MVP type 0)
+using OperandSpec = tmcl::OperandSpec;
+using MnemonicSpec = tmcl::MnemonicSpec;
 
 // Every mnemonic, sorted by command number.
 std::span<const MnemonicSpec> mnemonic_table();
@@ -54,10 +41,29 @@ std::string operand_synopsis(const MnemonicSpec& spec);
 // `text` is not such a number or does not fit in 64 bits.
 std::optional<int64_t> parse_integer(std::string_view text);
 
+// Why and where parse_instruction failed, for callers that point at the text (the assembler
+// reports file:line:column).
+enum class ParseErrorKind : uint8_t {
+  kSyntax,             // empty line or operand, malformed number
+  kUnknownMnemonic,    // the first word is neither a mnemonic nor a command number
+  kOperandCount,       // too few or too many operands
+  kUnknownIdentifier,  // neither a number, nor the operand's symbol, nor resolved by the caller
+  kOutOfRange,         // a number that does not fit its field
+};
+
+struct ParseErrorDetail {
+  ParseErrorKind kind = ParseErrorKind::kSyntax;
+  size_t offset = 0;  // byte offset in the parsed text of the word (or comma) at fault
+  size_t length = 0;  // its length (0: the end of the text, as for a missing operand)
+};
+
 struct ParseOptions {
   // Resolves identifiers that are neither numbers nor the operand's symbols (assembler labels
-  // and constants). Unset, or returning std::nullopt: "unknown symbol".
+  // and constants). Unset: "unknown symbol"; set but returning std::nullopt: "undefined label
+  // or constant".
   std::function<std::optional<int64_t>(std::string_view identifier)> resolve_identifier;
+  // When set, receives the kind and position of a parse error.
+  ParseErrorDetail* error_detail = nullptr;
 };
 
 // One instruction: a mnemonic and its operands, separated by commas and/or blanks

@@ -31,7 +31,7 @@ TEST(TmclErrors, unknown_parameter_gets_status_3) {
   Tmcm1636Rig rig;
   EXPECT_EQ(rig.command(6, 8, 0, 0).status, 3);    // GAP 8: no such axis parameter
   EXPECT_EQ(rig.command(5, 13, 0, 1).status, 3);   // SAP 13
-  EXPECT_EQ(rig.command(10, 67, 0, 0).status, 3);  // GGP 67: not on this module
+  EXPECT_EQ(rig.command(10, 68, 0, 0).status, 3);  // GGP 68: not on this module
   EXPECT_EQ(rig.command(36, 6, 0, 0).status, 3);   // CLE type 6
   EXPECT_EQ(rig.command(136, 2, 0, 0).status, 3);  // version type 2
   EXPECT_EQ(rig.command(4, 2, 0, 0).status, 3);    // MVP COORD: not on this module

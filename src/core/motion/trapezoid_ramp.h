@@ -33,6 +33,12 @@ class TrapezoidRamp {
   // Sets the position counter without moving (and, in position mode, the target with it,
   // so that the axis does not run off to the old target).
   void set_position(int32_t position);
+  // Sets position and velocity, keeping mode and target: a servo re-seeds its reference from
+  // the measured motion when it changes mode or its driver comes back on.
+  void set_state(int32_t position, double velocity) {
+    position_q16_ = static_cast<int64_t>(position) * (int64_t{1} << kFractionBits);
+    velocity_ = velocity;
+  }
   // Stops at once: velocity 0, position kept.
   void halt() {
     velocity_ = 0.0;

@@ -1,5 +1,7 @@
 #include "core/tmcl/engine.h"
 
+#include "core/tmcl/ascii_link.h"
+
 namespace motwin::tmcl {
 namespace {
 
@@ -74,6 +76,7 @@ bool is_control_command(uint8_t command) {
 }  // namespace
 
 void TmclEngine::power_up() {
+  ++power_up_count_;
   events_ = {};
   device_.power_up();
   ProgramMemory* memory = device_.program_memory();
@@ -258,6 +261,15 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       return CommandResult{Status::kOk, echo, ReplyKind::kNone, false};
     case command::kRequestPositionReachedEvent:
       return request_position_event(in, channel);
+    case command::kEnterAsciiMode:
+      // Only on modules with the ASCII interface: their global table has GP 67 (ascii_link.h).
+      {
+        int32_t configuration = 0;
+        if (device_.get_global_parameter(ascii_config::kGlobalParameter, 0, configuration) != Status::kOk) {
+          return status_only(Status::kInvalidCommand, echo);
+        }
+      }
+      return CommandResult{Status::kOk, echo, ReplyKind::kThenAsciiMode, false};
     case command::kSoftwareReset:
       if (in.value != kResetMagic) return status_only(Status::kInvalidValue, echo);
       return CommandResult{Status::kOk, echo, ReplyKind::kThenReset, false};

@@ -22,6 +22,7 @@ enum class ReplyKind : uint8_t {
   kVersionString,   // command 136 type 0: host address + 8 ASCII characters
   kNone,            // command 137: no reply
   kThenReset,       // command 255: reply first, then power-up
+  kThenAsciiMode,   // command 139: reply first (binary), then the link reads ASCII lines
 };
 
 struct CommandResult {
@@ -74,6 +75,8 @@ class TmclEngine {
   void complete_reset();
 
   size_t pending_event_count() const;
+  // Counts power-ups (start, 255, 137): links reset their mode (binary or ASCII, GP 67) on each.
+  uint32_t power_up_count() const { return power_up_count_; }
 
  private:
   struct PendingEvent {
@@ -89,6 +92,7 @@ class TmclEngine {
 
   TmclDevice& device_;
   std::array<PendingEvent, kMaxPendingEvents> events_{};
+  uint32_t power_up_count_ = 0;
   TmclInterpreter interpreter_;
 };
 

@@ -73,6 +73,9 @@ SerialResponse serve_serial_frame(TmclEngine& engine, const Frame& frame, Channe
     case ReplyKind::kThenReset:
       response.reset_after_send = true;
       break;
+    case ReplyKind::kThenAsciiMode:
+      response.enter_ascii_mode = true;
+      break;
     case ReplyKind::kNormal:
       break;
   }

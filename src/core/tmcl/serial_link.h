@@ -50,6 +50,7 @@ struct SerialResponse {
   Frame bytes{};
   uint8_t length = 0;         // 0: no reply (other address, command 137)
   bool reset_after_send = false;  // command 255: call TmclEngine::complete_reset() once sent
+  bool enter_ascii_mode = false;  // command 139: the link reads ASCII lines once this is sent
   uint8_t delay_ms = 0;       // GP 75 telegram pause before the reply
 };
 

@@ -78,6 +78,7 @@ void Tmcm1636::power_up() {
     const int32_t value = stored_value(kNvmLayout.axis_parameter(0, static_cast<uint8_t>(row.info.number)));
     if (params::in_range(row.info, value)) row.binding.set(*this, 0, value);
   }
+  axis_.finish_restore();  // later writes are host commands (AP 15 starts encoder initialisation)
   for (const auto& row : global_parameters().rows()) {
     if (!is_stored(row.info)) continue;
     const int32_t value = stored_value(kNvmLayout.global_parameter(static_cast<uint8_t>(row.info.number)));

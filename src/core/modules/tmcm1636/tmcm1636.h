@@ -23,6 +23,7 @@ namespace motwin::modules::tmcm1636 {
 struct GlobalConfig {
   int32_t serial_baud_rate_code = 7;   // GP 65, 115200 bit/s; no effect on a pseudo-terminal
   int32_t serial_address = 1;          // GP 66
+  int32_t ascii_mode = 0;              // GP 67 (Motwin extension): ASCII interface start mode and echo
   int32_t can_bit_rate_code = 8;       // GP 69, 1000 kbit/s
   int32_t can_send_id = 2;             // GP 70
   int32_t can_receive_id = 1;          // GP 71

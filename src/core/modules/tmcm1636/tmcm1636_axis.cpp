@@ -1,3 +1,5 @@
+// Commands of the TMCM-1636 axis and the ideal motor. The regulators that drive a real motor
+// through the power stage are in tmcm1636_axis_servo.cpp.
 #include "core/modules/tmcm1636/tmcm1636_axis.h"
 
 #include <cmath>
@@ -22,13 +24,18 @@ double Tmcm1636Axis::rpm(double counts_per_second) const {
   return counts_per_second * 60.0 / static_cast<double>(config.encoder_steps);
 }
 
+// A servo starts a new mode from the motion it measures, so that a mode change is bumpless.
+void Tmcm1636Axis::seed_ramp() { ramp_.set_state(state.actual_position, servo_.velocity_counts_per_s); }
+
 void Tmcm1636Axis::set_target_velocity(int32_t velocity_rpm) {
+  if (power_stage_ != nullptr && state.mode != MotionMode::kVelocity) seed_ramp();
   state.mode = MotionMode::kVelocity;
   state.target_velocity_rpm = velocity_rpm;
   ramp_.set_velocity_target(counts_per_second(velocity_rpm));
 }
 
 void Tmcm1636Axis::set_target_position(int32_t position) {
+  if (power_stage_ != nullptr && state.mode != MotionMode::kPosition) seed_ramp();
   state.mode = MotionMode::kPosition;
   ramp_.set_position_target(position);
   update_position_reached();
@@ -54,10 +61,11 @@ void Tmcm1636Axis::set_target_flux(int32_t flux_ma) {
   ramp_.halt();
 }
 
-// A disabled driver lets the ideal motor stop where it is.
+// A disabled driver lets the ideal motor stop where it is; a real motor coasts (the bridge is
+// off, see servo_tick()).
 void Tmcm1636Axis::set_driver_enabled(bool enabled) {
   state.driver_enabled = enabled ? 1 : 0;
-  if (!enabled) {
+  if (!enabled && power_stage_ == nullptr) {
     const MotionMode mode = state.mode;
     const int32_t target = ramp_.target_position();
     ramp_.halt();
@@ -65,24 +73,68 @@ void Tmcm1636Axis::set_driver_enabled(bool enabled) {
   }
 }
 
+void Tmcm1636Axis::set_commutation_mode(int32_t mode) {
+  config.commutation_mode = mode;
+  if (restoring_ || power_stage_ == nullptr) return;
+  if (mode == 3) {
+    start_encoder_init(false);
+  } else if (mode == 4 && config.absolute_encoder_init == 0) {
+    start_encoder_init(true);
+  } else {
+    state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kIdle);
+  }
+}
+
+void Tmcm1636Axis::set_clear_on_null(int32_t clear) {
+  config.clear_on_null = clear;
+  servo_.clear_armed = clear != 0;
+}
+
 void Tmcm1636Axis::reset_state() {
   state = AxisState{};
   ramp_ = motion::TrapezoidRamp{};
+  servo_ = Servo{};
+  restoring_ = true;
 }
 
-void Tmcm1636Axis::update_switches(const board::Tmcm1636Io& io) {
+void Tmcm1636Axis::update_switches(uint8_t levels) {
   const auto active = [&](board::ReferenceSwitch which) {
     const int bit = static_cast<int>(which);
     const bool high_active = ((config.reference_switch_polarity >> bit) & 1) != 0;
-    return io.reference_switch_level(which) == high_active;
+    return (((levels >> bit) & 1) != 0) == high_active;
   };
   state.right_switch_active = active(board::ReferenceSwitch::kRight) ? 1 : 0;
   state.left_switch_active = active(board::ReferenceSwitch::kLeft) ? 1 : 0;
   state.home_switch_active = active(board::ReferenceSwitch::kHome) ? 1 : 0;
 }
 
+bool Tmcm1636Axis::switch_blocks(double direction) const {
+  if (direction > 0.0) return (config.reference_switch_enable & 1) != 0 && state.right_switch_active != 0;
+  if (direction < 0.0) return (config.reference_switch_enable & 2) != 0 && state.left_switch_active != 0;
+  return false;
+}
+
+void Tmcm1636Axis::stop_at_switch() {
+  ramp_.halt();
+  state.target_velocity_rpm = 0;
+  state.mode = MotionMode::kVelocity;
+}
+
 void Tmcm1636Axis::tick(const board::Tmcm1636Io& io, double dt_s) {
-  update_switches(io);
+  restoring_ = false;
+  if (power_stage_ != nullptr) {
+    servo_tick(*power_stage_, dt_s);
+  } else {
+    ideal_tick(io, dt_s);
+  }
+}
+
+void Tmcm1636Axis::ideal_tick(const board::Tmcm1636Io& io, double dt_s) {
+  uint8_t levels = 0;
+  if (io.reference_switch_level(board::ReferenceSwitch::kRight)) levels |= 1;
+  if (io.reference_switch_level(board::ReferenceSwitch::kLeft)) levels |= 2;
+  if (io.reference_switch_level(board::ReferenceSwitch::kHome)) levels |= 4;
+  update_switches(levels);
   if (state.driver_enabled != 0 && state.mode != MotionMode::kTorque) {
     const motion::TrapezoidRampConfig ramp_config{
         counts_per_second(config.max_velocity_rpm),
@@ -93,26 +145,40 @@ void Tmcm1636Axis::tick(const board::Tmcm1636Io& io, double dt_s) {
     if (state.mode == MotionMode::kVelocity) ramp_.set_velocity_target(counts_per_second(state.target_velocity_rpm));
     ramp_.step(ramp_config, dt_s);
     // An enabled reference switch stops motion towards it at once (AP 209).
-    const double velocity = ramp_.velocity();
-    const bool right_blocked = (config.reference_switch_enable & 1) != 0 && state.right_switch_active != 0 && velocity > 0.0;
-    const bool left_blocked = (config.reference_switch_enable & 2) != 0 && state.left_switch_active != 0 && velocity < 0.0;
-    if (right_blocked || left_blocked) {
-      ramp_.halt();
-      state.target_velocity_rpm = 0;
-      state.mode = MotionMode::kVelocity;
-    }
+    if (switch_blocks(ramp_.velocity())) stop_at_switch();
   }
   // The ideal motor is wherever the ramp is.
   state.actual_position = ramp_.position();
   state.ramp_velocity_rpm = round_to_int32(rpm(ramp_.velocity()));
   state.actual_velocity_rpm = state.driver_enabled != 0 ? state.ramp_velocity_rpm : 0;
   update_position_reached();
+  uint32_t flags = state.driver_enabled != 0 ? status_flag::kDriverEnabled : 0;
+  flags |= state.mode == MotionMode::kTorque     ? status_flag::kTorqueMode
+           : state.mode == MotionMode::kPosition ? status_flag::kPositionMode
+                                                 : status_flag::kVelocityMode;
+  if (state.position_reached != 0) flags |= status_flag::kPositionReached;
+  if (switch_blocks(1.0)) flags |= status_flag::kRightSwitchStop;
+  if (switch_blocks(-1.0)) flags |= status_flag::kLeftSwitchStop;
+  state.status_flags = flags;
 }
 
 // AP 55: |target - actual| <= AP 53 and |actual velocity| <= AP 54.
 void Tmcm1636Axis::update_position_reached() {
+  if (power_stage_ != nullptr) {
+    update_position_reached_servo();
+    return;
+  }
   const double distance = std::fabs(ramp_.distance_to_target());
   const bool near = distance <= static_cast<double>(config.position_reached_distance);
+  const bool slow = std::abs(state.actual_velocity_rpm) <= config.position_reached_velocity_rpm;
+  state.position_reached = near && slow ? 1 : 0;
+}
+
+void Tmcm1636Axis::update_position_reached_servo() {
+  const auto distance =
+      static_cast<int32_t>(static_cast<uint32_t>(ramp_.target_position()) - static_cast<uint32_t>(state.actual_position));
+  const int64_t magnitude = distance < 0 ? -static_cast<int64_t>(distance) : distance;
+  const bool near = magnitude <= config.position_reached_distance;
   const bool slow = std::abs(state.actual_velocity_rpm) <= config.position_reached_velocity_rpm;
   state.position_reached = near && slow ? 1 : 0;
 }

@@ -1,12 +1,21 @@
-// Axis 0 of the TMCM-1636: its settings (the E parameters of manual table 11), its live
-// state, and the motion of the *ideal* motor, which follows the ramp generator exactly. The
-// BLDC physics issue adds the FOC cascade and a plant; the ideal motor stays as the fast
-// option.
+// Axis 0 of the TMCM-1636: its settings (the E parameters of manual table 11), its live state,
+// and its motion. Two motors:
+//  - the *ideal* motor (no power stage attached): the axis follows the ramp generator exactly,
+//    the fast option (docs/tmcm-1636.md);
+//  - a real motor behind the power-stage seam (board/tmcm1636_power_stage.h): the cascaded
+//    regulators of manual chapter 5 (FOC current/flux PI, velocity PI, position P), commutation
+//    (open loop, digital hall, ABN encoder, absolute encoder), encoder initialisation, brake,
+//    brake chopper and protections, reading only ADC counts, hall levels and encoder counts and
+//    writing only PWM duties and outputs (docs/tmcm-1636-servo.md).
 #pragma once
 
 #include <cstdint>
 
 #include "board/tmcm1636_io.h"
+#include "board/tmcm1636_power_stage.h"
+#include "core/motion/hall_decoder.h"
+#include "core/motion/pi_regulator.h"
+#include "core/motion/position_pll.h"
 #include "core/motion/trapezoid_ramp.h"
 
 namespace motwin::modules::tmcm1636 {
@@ -16,7 +25,7 @@ namespace motwin::modules::tmcm1636 {
 struct AxisConfig {
   int32_t adc_phase_a_offset = 32767;        // AP 5
   int32_t adc_phase_b_offset = 32767;        // AP 6
-  int32_t dual_shunt_factor = 256;           // AP 7
+  int32_t dual_shunt_factor = 256;           // AP 7: mA = (raw - offset) * factor / 256
   int32_t motor_pole_pairs = 4;              // AP 10
   int32_t max_current_ma = 2000;             // AP 11
   int32_t open_loop_current_ma = 2000;       // AP 12
@@ -28,18 +37,16 @@ struct AxisConfig {
   int32_t velocity_ramp_enabled = 1;         // AP 45
   int32_t position_reached_distance = 5;     // AP 53, position counts
   int32_t position_reached_velocity_rpm = 500;  // AP 54
-  int32_t torque_p = 0;                      // AP 70
-  int32_t torque_i = 0;                      // AP 71
-  int32_t velocity_p = 0;                    // AP 72
-  int32_t velocity_i = 0;                    // AP 73
-  int32_t position_p = 0;                    // AP 74
+  motion::PiConfig current_pi;               // AP 70 (P), 71 (I): torque and flux regulators
+  motion::PiConfig velocity_pi;              // AP 72, 73
+  motion::PiConfig position_pi;              // AP 74 (P only; I stays 0)
   int32_t hall_polarity = 0;                 // AP 90
   int32_t hall_direction = 0;                // AP 91
   int32_t hall_interpolation = 0;            // AP 92
   int32_t hall_phi_e_offset = 0;             // AP 93
   int32_t encoder_steps = 8192;              // AP 100, counts per revolution
   int32_t encoder_direction = 0;             // AP 101
-  int32_t encoder_init_mode = 1;             // AP 102
+  int32_t encoder_init_mode = 1;             // AP 102: 0 estimate, 1 N channel, 2 hall
   int32_t encoder_init_delay_ms = 1000;      // AP 104
   int32_t encoder_init_velocity_rpm = 100;   // AP 105
   int32_t encoder_offset = 0;                // AP 106
@@ -49,31 +56,65 @@ struct AxisConfig {
   int32_t brake_release_duty_percent = 75;   // AP 121
   int32_t brake_hold_duty_percent = 11;      // AP 122
   int32_t brake_release_duration_ms = 80;    // AP 123
-  int32_t brake_output_enable = 0;           // AP 124
-  int32_t brake_output_invert = 0;           // AP 125
+  int32_t brake_output_enable = 0;           // AP 124 (manual: 0 enabled, 1 disabled)
+  int32_t brake_output_invert = 0;           // AP 125 (manual: 0 "inverted", 1 "normal")
   int32_t brake_chopper_enabled = 0;         // AP 140
   int32_t brake_chopper_limit_decivolt = 260;     // AP 141
   int32_t brake_chopper_hysteresis_decivolt = 5;  // AP 142
-  int32_t absolute_encoder_type = 0;         // AP 160
-  int32_t absolute_encoder_init = 0;         // AP 161
+  int32_t absolute_encoder_type = 0;         // AP 160: 0 none, 1 AMT20 (12 bit), 2 AMT23 (14 bit)
+  int32_t absolute_encoder_init = 0;         // AP 161: 0 estimate offset, 1 use AP 163
   int32_t absolute_encoder_direction = 0;    // AP 162
-  int32_t absolute_encoder_offset = 0;       // AP 163
+  int32_t absolute_encoder_offset = 0;       // AP 163, 65536 per mechanical revolution
   int32_t reference_switch_enable = 0;       // AP 209: bit 0 right, bit 1 left
   int32_t reference_switch_polarity = 0;     // AP 210: bit 0 right, 1 left, 2 home; 1 = high active
 };
 
 enum class MotionMode : uint8_t { kVelocity, kPosition, kTorque };
 
+// AP 103 (manual table 11).
+enum class EncoderInitState : int32_t { kIdle = 0, kStartInit = 1, kWaitInitTime = 2, kEstimateOffset = 3 };
+
+// AP 156 status flags (docs/tmcm-1636-servo.md, "Status flags").
+namespace status_flag {
+inline constexpr uint32_t kDriverEnabled = 1u << 0;        // AP 255 = 1
+inline constexpr uint32_t kPowerStageOn = 1u << 1;         // the bridge switches
+inline constexpr uint32_t kTorqueMode = 1u << 2;
+inline constexpr uint32_t kVelocityMode = 1u << 3;
+inline constexpr uint32_t kPositionMode = 1u << 4;
+inline constexpr uint32_t kPositionReached = 1u << 5;      // AP 55
+inline constexpr uint32_t kCurrentLimit = 1u << 6;         // torque demand clipped at AP 11
+inline constexpr uint32_t kVelocityLimit = 1u << 7;        // velocity demand clipped at AP 43
+inline constexpr uint32_t kVoltageLimit = 1u << 8;         // current regulator at the supply limit
+inline constexpr uint32_t kEncoderInitialised = 1u << 9;   // ABN offset found since power-up
+inline constexpr uint32_t kEncoderInitRunning = 1u << 10;  // AP 103 != 0
+inline constexpr uint32_t kAbsoluteEncoderReady = 1u << 11;
+inline constexpr uint32_t kHallError = 1u << 12;           // hall state 000 or 111
+inline constexpr uint32_t kBrakeReleased = 1u << 13;
+inline constexpr uint32_t kBrakeChopperActive = 1u << 14;
+inline constexpr uint32_t kUndervoltage = 1u << 15;
+inline constexpr uint32_t kOvervoltage = 1u << 16;
+inline constexpr uint32_t kOvertemperature = 1u << 17;
+inline constexpr uint32_t kRightSwitchStop = 1u << 18;
+inline constexpr uint32_t kLeftSwitchStop = 1u << 19;
+inline constexpr uint32_t kAll = (1u << 20) - 1;
+}  // namespace status_flag
+
+// Protection thresholds of the power stage (docs/tmcm-1636-servo.md).
+inline constexpr int32_t kUndervoltageTripDecivolt = 80;
+inline constexpr int32_t kUndervoltageClearDecivolt = 90;
+inline constexpr int32_t kOvervoltageTripDecivolt = 600;
+inline constexpr int32_t kOvervoltageClearDecivolt = 580;
+inline constexpr int32_t kOvertemperatureTripCelsius = 100;
+inline constexpr int32_t kOvertemperatureClearCelsius = 90;
+
 // Live values: measured, computed, or commanded without being stored.
 struct AxisState {
   MotionMode mode = MotionMode::kVelocity;
-  // Current measurement (AP 0..4); mid-scale raw counts mean zero current. Live once the
-  // BLDC physics issue lands.
   int32_t adc_phase_a_raw = 32767;  // AP 0
   int32_t adc_phase_b_raw = 32767;  // AP 1
-  int32_t adc_phase_a = 0;          // AP 2
-  int32_t adc_phase_b = 0;          // AP 3
-  int32_t adc_phase_c = 0;          // AP 4
+  int32_t adc_phase_a = 0;          // AP 2, mA
+  int32_t adc_phase_b = 0;          // AP 3, mA
+  int32_t adc_phase_c = 0;          // AP 4, mA
   int32_t open_loop_angle = 0;      // AP 16
   int32_t encoder_angle = 0;        // AP 17
   int32_t hall_angle = 0;           // AP 18
@@ -87,17 +128,14 @@ struct AxisState {
   int32_t actual_velocity_rpm = 0;  // AP 42
   int32_t actual_position = 0;      // AP 52
   int32_t position_reached = 0;     // AP 55
-  int32_t torque_error_sum = 0;     // AP 75
-  int32_t flux_error_sum = 0;       // AP 76
-  int32_t velocity_error_sum = 0;   // AP 77
-  int32_t torque_error = 0;         // AP 78
-  int32_t flux_error = 0;           // AP 79
-  int32_t velocity_error = 0;       // AP 80
-  int32_t position_error = 0;       // AP 81
+  motion::PiState torque_pi;        // AP 75 (error sum), 78 (error)
+  motion::PiState flux_pi;          // AP 76, 79
+  motion::PiState velocity_pi;      // AP 77, 80
+  motion::PiState position_pi;      // AP 81
   int32_t encoder_init_state = 0;   // AP 103
   int32_t release_brake = 0;        // AP 120
   int32_t brake_chopper_active = 0;  // AP 144 (the manual's default column says 255)
-  int32_t status_flags = 0;         // AP 156, bits defined by the BLDC physics issue
+  uint32_t status_flags = 0;        // AP 156, status_flag bits
   int32_t right_switch_active = 0;  // AP 211
   int32_t left_switch_active = 0;   // AP 212
   int32_t home_switch_active = 0;   // AP 213
@@ -120,27 +158,110 @@ class Tmcm1636Axis {
   void set_target_torque(int32_t torque_ma);
   void set_target_flux(int32_t flux_ma);
   void set_driver_enabled(bool enabled);
+  // AP 15: selecting ABN (3) or absolute encoder (4, AP 161 = 0) commutation starts the
+  // encoder initialisation; restoring AP 15 at power-up does not (docs/tmcm-1636-servo.md).
+  void set_commutation_mode(int32_t mode);
+  // AP 107: writing it re-arms the clear on the next N pulse.
+  void set_clear_on_null(int32_t clear);
 
-  // One control tick of `dt_s` seconds with the ideal motor.
+  // The motor behind the power stage. nullptr (the default) is the ideal motor. The stage is
+  // board wiring: it survives reset_state().
+  void attach_power_stage(board::Tmcm1636PowerStage* stage) { power_stage_ = stage; }
+  bool has_power_stage() const { return power_stage_ != nullptr; }
+
+  // One control tick of `dt_s` seconds: the ideal motor, or the regulators on the power stage.
   void tick(const board::Tmcm1636Io& io, double dt_s);
 
-  // Power-up: live state cleared, settings kept.
+  // Power-up: live state cleared, settings kept. Parameter writes until finish_restore() (or
+  // the first tick) are the restore from the EEPROM image, not host commands.
   void reset_state();
+  void finish_restore() { restoring_ = false; }
 
   int32_t target_position() const { return ramp_.target_position(); }
   int32_t ramp_position() const { return ramp_.position(); }
   bool position_reached() const { return state.position_reached != 0; }
   const motion::TrapezoidRamp& ramp() const { return ramp_; }
+  bool encoder_initialised() const { return servo_.abn_initialised; }
 
   // rpm <-> position counts per second, with AP 100 counts per revolution.
   double counts_per_second(double velocity_rpm) const;
   double rpm(double counts_per_second) const;
 
  private:
-  void update_switches(const board::Tmcm1636Io& io);
+  // Everything the regulators keep between ticks that is not a parameter.
+  struct Servo {
+    bool started = false;           // first tick since power-up done
+    // ABN encoder: the commutation counter (direction applied, since power-up or the N pulse of
+    // an N-channel initialisation) and the last raw reading.
+    int32_t abn_last_raw = 0;
+    int64_t abn_count = 0;
+    int64_t abn_reference = 0;      // commutation counter value that counts as 0
+    uint32_t abn_index_events = 0;
+    bool abn_initialised = false;
+    bool clear_armed = false;       // AP 107 clear pending
+    motion::HallDecoder hall;
+    int32_t hall_last_steps = 0;
+    uint16_t absolute_last = 0;
+    uint32_t open_loop_phase = 0;   // electrical angle, 2^32 per turn (wraps)
+    uint32_t open_loop_last = 0;
+    bool absolute_estimated = false;
+    // Position source in AP 100 counts, continuous, and the fractions left over by scaling.
+    int64_t sensor_position = 0;
+    int64_t hall_remainder = 0;
+    int64_t absolute_remainder = 0;
+    int64_t open_loop_remainder = 0;
+    motion::PositionPll pll;
+    double velocity_counts_per_s = 0.0;
+    // Encoder initialisation.
+    bool init_for_absolute = false;
+    uint32_t init_ticks = 0;
+    // Power stage.
+    bool undervoltage = false;
+    bool overvoltage = false;
+    bool overtemperature = false;
+    bool chopper_on = false;
+    int32_t brake_previous_release = 0;
+    uint32_t brake_release_ticks = 0;
+    // Loop counters for AP 230..232.
+    uint32_t window_ticks = 0;
+    uint32_t torque_loops = 0;
+    uint32_t velocity_loops = 0;
+    uint32_t flags = 0;             // limit flags collected during a tick
+    double inverse_encoder_steps = 1.0 / 8192.0;  // 1 / AP 100, refreshed every tick
+  };
+
+  void ideal_tick(const board::Tmcm1636Io& io, double dt_s);
+  void servo_tick(board::Tmcm1636PowerStage& stage, double dt_s);
+  void update_switches(uint8_t levels);
   void update_position_reached();
+  void update_position_reached_servo();
+  void read_sensors(const board::Tmcm1636Feedback& feedback, double dt_s);
+  void start_encoder_init(bool absolute);
+  bool run_encoder_init(const board::Tmcm1636Feedback& feedback, uint16_t& angle, float& id_ref, double dt_s);
+  void update_brake(board::Tmcm1636Drive& drive, double dt_s);
+  void update_protection(const board::Tmcm1636Feedback& feedback, int32_t supply_decivolt);
+  float velocity_reference_rpm(double dt_s);
+  bool switch_blocks(double direction) const;
+  void stop_at_switch();
+  void seed_ramp();
+  void reset_regulators();
+  uint16_t abn_angle() const;
+  uint16_t absolute_angle(uint16_t mechanical) const;
+  int64_t position_source_count() const;
+
+  // rpm <-> counts/s factors of the servo path, refreshed once per tick from AP 100 (saves the
+  // divisions of rpm() and counts_per_second() in the hot path).
+  double to_rpm(double counts_per_s) const { return counts_per_s * rpm_per_count_per_s_; }
+  double to_counts_per_s(double velocity_rpm) const { return velocity_rpm * counts_per_s_per_rpm_; }
 
   motion::TrapezoidRamp ramp_;
+  Servo servo_;
+  double rpm_per_count_per_s_ = 60.0 / 8192.0;
+  double counts_per_s_per_rpm_ = 8192.0 / 60.0;
+  board::Tmcm1636PowerStage* power_stage_ = nullptr;
+  // Set by reset_state(), cleared by the first tick: parameter writes in between are the
+  // power-up restore, not host commands.
+  bool restoring_ = false;
 };
 
 }  // namespace motwin::modules::tmcm1636

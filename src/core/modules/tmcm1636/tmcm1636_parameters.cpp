@@ -42,6 +42,26 @@ constexpr Binding<Tmcm1636> state_field() {
   return params::field_binding<Tmcm1636, axis_state, Field>();
 }
 
+// The regulators' gains (AP 70..74) and their live errors and error sums (AP 75..81) are the
+// fields of their motion::PiConfig and motion::PiState (core/motion/pi_regulator.h).
+motion::PiConfig& current_pi_config(Tmcm1636& m) { return m.axis().config.current_pi; }
+motion::PiConfig& velocity_pi_config(Tmcm1636& m) { return m.axis().config.velocity_pi; }
+motion::PiConfig& position_pi_config(Tmcm1636& m) { return m.axis().config.position_pi; }
+motion::PiState& torque_pi_state(Tmcm1636& m) { return m.axis().state.torque_pi; }
+motion::PiState& flux_pi_state(Tmcm1636& m) { return m.axis().state.flux_pi; }
+motion::PiState& velocity_pi_state(Tmcm1636& m) { return m.axis().state.velocity_pi; }
+motion::PiState& position_pi_state(Tmcm1636& m) { return m.axis().state.position_pi; }
+
+template <auto Part, int32_t motion::PiConfig::*Field>
+constexpr Binding<Tmcm1636> pi_gain() {
+  return params::field_binding<Tmcm1636, Part, Field>();
+}
+
+template <auto Part, int32_t motion::PiState::*Field>
+constexpr Binding<Tmcm1636> pi_value() {
+  return params::field_binding<Tmcm1636, Part, Field, false>();
+}
+
 template <int kIndex>
 constexpr Binding<Tmcm1636> debug_value() {
   return {[](Tmcm1636& m, uint8_t) { return m.axis().state.debug_values[kIndex]; },
@@ -56,6 +76,20 @@ constexpr Binding<Tmcm1636> global_field() {
   return params::field_binding<Tmcm1636, global_config, Field>();
 }
 
+// AP 15: selecting ABN or absolute encoder commutation starts the encoder initialisation.
+constexpr Binding<Tmcm1636> kCommutationMode{
+    [](Tmcm1636& m, uint8_t) { return m.axis().config.commutation_mode; },
+    [](Tmcm1636& m, uint8_t, int32_t value) {
+      m.axis().set_commutation_mode(value);
+      return Status::kOk;
+    }};
+// AP 107: a write re-arms the clear at the next N pulse (AP 108 = 1 clears only once).
+constexpr Binding<Tmcm1636> kClearOnNull{
+    [](Tmcm1636& m, uint8_t) { return m.axis().config.clear_on_null; },
+    [](Tmcm1636& m, uint8_t, int32_t value) {
+      m.axis().set_clear_on_null(value);
+      return Status::kOk;
+    }};
 constexpr Binding<Tmcm1636> kTargetTorque{
     [](Tmcm1636& m, uint8_t) { return m.axis().state.target_torque_ma; },
     [](Tmcm1636& m, uint8_t, int32_t value) {
@@ -108,9 +142,9 @@ constexpr Binding<Tmcm1636> kDriverTemperature{
 constexpr Row kAxisRows[] = {
   {{0, "adc_I0_raw", 0, 65535, 32767, access("R"), Unit::kAdcCount, "Raw ADC measurement of the phase A shunt"}, state_value<&AxisState::adc_phase_a_raw>()},
   {{1, "adc_I1_raw", 0, 65535, 32767, access("R"), Unit::kAdcCount, "Raw ADC measurement of the phase B shunt"}, state_value<&AxisState::adc_phase_b_raw>()},
-  {{2, "adc_I0", -32768, 32767, 0, access("R"), Unit::kAdcCount, "Phase A current from its shunt and offset"}, state_value<&AxisState::adc_phase_a>()},
-  {{3, "adc_I1", -32768, 32767, 0, access("R"), Unit::kAdcCount, "Phase B current from its shunt and offset"}, state_value<&AxisState::adc_phase_b>()},
-  {{4, "adc_I2", -32768, 32767, 0, access("R"), Unit::kAdcCount, "Phase C current computed from phases A and B"}, state_value<&AxisState::adc_phase_c>()},
+  {{2, "adc_I0", -32768, 32767, 0, access("R"), Unit::kMilliampere, "Phase A current: (AP 0 - AP 5) * AP 7 / 256"}, state_value<&AxisState::adc_phase_a>()},
+  {{3, "adc_I1", -32768, 32767, 0, access("R"), Unit::kMilliampere, "Phase B current: (AP 1 - AP 6) * AP 7 / 256"}, state_value<&AxisState::adc_phase_b>()},
+  {{4, "adc_I2", -32768, 32767, 0, access("R"), Unit::kMilliampere, "Phase C current: -(AP 2 + AP 3)"}, state_value<&AxisState::adc_phase_c>()},
   {{5, "adc_I0_offset", 0, 65535, 32767, access("RWEX"), Unit::kAdcCount, "Dual-shunt phase A offset"}, config_field<&AxisConfig::adc_phase_a_offset>()},
   {{6, "adc_I1_offset", 0, 65535, 32767, access("RWEX"), Unit::kAdcCount, "Dual-shunt phase B offset"}, config_field<&AxisConfig::adc_phase_b_offset>()},
   {{7, "dual shunt factor", 1, 65535, 256, access("RWEX"), Unit::kNone, "Dual-shunt current measurement factor"}, config_field<&AxisConfig::dual_shunt_factor>()},
@@ -118,7 +152,7 @@ constexpr Row kAxisRows[] = {
   {{11, "max current", 0, 60000, 2000, access("RWEX"), Unit::kMilliampere, "Maximum absolute motor current"}, config_field<&AxisConfig::max_current_ma>()},
   {{12, "open loop current", 0, 60000, 2000, access("RWEX"), Unit::kMilliampere, "Motor current in open-loop commutation (mode 1)"}, config_field<&AxisConfig::open_loop_current_ma>()},
   {{14, "motor type", 0, 3, 0, access("RWEX"), Unit::kNone, "0 no motor, 1 single phase DC, 3 three phase BLDC"}, config_field<&AxisConfig::motor_type>()},
-  {{15, "commutation mode", 0, 4, 0, access("RWEX"), Unit::kNone, "0 disabled, 1 open loop, 2 digital hall, 3 ABN encoder, 4 absolute encoder"}, config_field<&AxisConfig::commutation_mode>()},
+  {{15, "commutation mode", 0, 4, 0, access("RWEX"), Unit::kNone, "0 disabled, 1 open loop, 2 digital hall, 3 ABN encoder, 4 absolute encoder; 3 and 4 start the encoder initialisation"}, kCommutationMode},
   {{16, "open loop commutation angle", -32768, 32767, 0, access("R"), Unit::kNone, "Actual open-loop angle"}, state_value<&AxisState::open_loop_angle>()},
   {{17, "encoder commutation angle", -32768, 32767, 0, access("R"), Unit::kNone, "Actual ABN encoder angle"}, state_value<&AxisState::encoder_angle>()},
   {{18, "digital hall commutation angle", -32768, 32767, 0, access("R"), Unit::kNone, "Actual digital hall angle"}, state_value<&AxisState::hall_angle>()},
@@ -140,18 +174,18 @@ constexpr Row kAxisRows[] = {
   {{53, "position reached distance", 0, 100000, 5, access("RWEX"), Unit::kPositionCount, "Largest distance at which the position reached flag is set"}, config_field<&AxisConfig::position_reached_distance>()},
   {{54, "position reached velocity", 0, 200000, 500, access("RWEX"), Unit::kRpm, "Largest velocity at which the position reached flag is set"}, config_field<&AxisConfig::position_reached_velocity_rpm>()},
   {{55, "position reached flag", 0, 1, 0, access("R"), Unit::kNone, "1 when actual position and velocity are within the target window"}, state_value<&AxisState::position_reached>()},
-  {{70, "torque P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P parameter of the current regulator"}, config_field<&AxisConfig::torque_p>()},
-  {{71, "torque I", 0, 32767, 0, access("RWEX"), Unit::kNone, "I parameter of the current regulator"}, config_field<&AxisConfig::torque_i>()},
-  {{72, "velocity P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P parameter of the velocity regulator"}, config_field<&AxisConfig::velocity_p>()},
-  {{73, "velocity I", 0, 32767, 0, access("RWEX"), Unit::kNone, "I parameter of the velocity regulator"}, config_field<&AxisConfig::velocity_i>()},
-  {{74, "position P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P parameter of the position regulator"}, config_field<&AxisConfig::position_p>()},
-  {{75, "torque PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the current regulator"}, state_value<&AxisState::torque_error_sum>()},
-  {{76, "flux PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the flux regulator"}, state_value<&AxisState::flux_error_sum>()},
-  {{77, "velocity PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the velocity regulator"}, state_value<&AxisState::velocity_error_sum>()},
-  {{78, "torque PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the current regulator"}, state_value<&AxisState::torque_error>()},
-  {{79, "flux PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the flux regulator"}, state_value<&AxisState::flux_error>()},
-  {{80, "velocity PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the velocity regulator"}, state_value<&AxisState::velocity_error>()},
-  {{81, "position PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the position regulator"}, state_value<&AxisState::position_error>()},
+  {{70, "torque P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P of the torque and flux regulators: mV = P * error[mA] / 256"}, pi_gain<current_pi_config, &motion::PiConfig::p>()},
+  {{71, "torque I", 0, 32767, 0, access("RWEX"), Unit::kNone, "I of the torque and flux regulators: mV = I * error sum[mA*ticks] / 65536"}, pi_gain<current_pi_config, &motion::PiConfig::i>()},
+  {{72, "velocity P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P of the velocity regulator: mA = P * error[rpm] / 256"}, pi_gain<velocity_pi_config, &motion::PiConfig::p>()},
+  {{73, "velocity I", 0, 32767, 0, access("RWEX"), Unit::kNone, "I of the velocity regulator: mA = I * error sum[rpm*ticks] / 65536"}, pi_gain<velocity_pi_config, &motion::PiConfig::i>()},
+  {{74, "position P", 0, 32767, 0, access("RWEX"), Unit::kNone, "P of the position regulator: rpm = P * error[counts] / 256"}, pi_gain<position_pi_config, &motion::PiConfig::p>()},
+  {{75, "torque PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the torque (q current) regulator, mA*ticks"}, pi_value<torque_pi_state, &motion::PiState::error_sum>()},
+  {{76, "flux PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the flux (d current) regulator, mA*ticks"}, pi_value<flux_pi_state, &motion::PiState::error_sum>()},
+  {{77, "velocity PI error sum", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error sum of the velocity regulator, rpm*ticks"}, pi_value<velocity_pi_state, &motion::PiState::error_sum>()},
+  {{78, "torque PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the torque regulator, mA"}, pi_value<torque_pi_state, &motion::PiState::error>()},
+  {{79, "flux PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the flux regulator, mA"}, pi_value<flux_pi_state, &motion::PiState::error>()},
+  {{80, "velocity PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the velocity regulator, rpm"}, pi_value<velocity_pi_state, &motion::PiState::error>()},
+  {{81, "position PI error", kMin32, kMax32, 0, access("R"), Unit::kNone, "Error of the position regulator, counts"}, pi_value<position_pi_state, &motion::PiState::error>()},
   {{90, "hall polarity", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted"}, config_field<&AxisConfig::hall_polarity>()},
   {{91, "hall direction", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted"}, config_field<&AxisConfig::hall_direction>()},
   {{92, "hall interpolation", 0, 1, 0, access("RWEX"), Unit::kNone, "0 off, 1 on"}, config_field<&AxisConfig::hall_interpolation>()},
@@ -162,8 +196,8 @@ constexpr Row kAxisRows[] = {
   {{103, "encoder init state", 0, 3, 0, access("R"), Unit::kNone, "0 idle, 1 start, 2 wait init time, 3 estimate offset"}, state_value<&AxisState::encoder_init_state>()},
   {{104, "encoder init delay", 0, 10000, 1000, access("RWEX"), Unit::kMillisecond, "Duration of the encoder initialisation"}, config_field<&AxisConfig::encoder_init_delay_ms>()},
   {{105, "encoder init velocity", -200000, 200000, 100, access("RWEX"), Unit::kRpm, "Velocity of the N-channel encoder initialisation"}, config_field<&AxisConfig::encoder_init_velocity_rpm>()},
-  {{106, "encoder offset", 0, 65535, 0, access("RWE"), Unit::kNone, "Commutation offset of the encoder"}, config_field<&AxisConfig::encoder_offset>()},
-  {{107, "clear on null", 0, 1, 0, access("RWEX"), Unit::kNone, "1 clears the position counter at the next N channel event"}, config_field<&AxisConfig::clear_on_null>()},
+  {{106, "encoder offset", 0, 65535, 0, access("RWE"), Unit::kNone, "ABN counter value (mod AP 100) at electrical angle 0"}, config_field<&AxisConfig::encoder_offset>()},
+  {{107, "clear on null", 0, 1, 0, access("RWEX"), Unit::kNone, "1 clears the position counter at the next N channel event"}, kClearOnNull},
   {{108, "clear once", 0, 1, 0, access("RWEX"), Unit::kNone, "1 clears only once, 0 at every N channel event"}, config_field<&AxisConfig::clear_once>()},
   {{110, "motor PWM frequency", 25000, 100000, 25000, access("RWEX"), Unit::kHertz, "Frequency of the motor PWM"}, config_field<&AxisConfig::pwm_frequency_hz>()},
   {{120, "release brake", 0, 1, 0, access("RW"), Unit::kNone, "1 brake PWM active (brake released)"}, state_field<&AxisState::release_brake>()},
@@ -176,11 +210,11 @@ constexpr Row kAxisRows[] = {
   {{141, "brake chopper voltage limit", 50, 600, 260, access("RWE"), Unit::kDecivolt, "Supply voltage above which the chopper switches on"}, config_field<&AxisConfig::brake_chopper_limit_decivolt>()},
   {{142, "brake chopper hysteresis", 0, 50, 5, access("RWE"), Unit::kDecivolt, "Chopper switches off below limit minus hysteresis"}, config_field<&AxisConfig::brake_chopper_hysteresis_decivolt>()},
   {{144, "brake chopper active", 0, 600, 255, access("R"), Unit::kNone, "Non-zero while the brake chopper is on"}, state_value<&AxisState::brake_chopper_active>()},
-  {{156, "status flags", 0, 0, 0, access("R"), Unit::kNone, "Actual status flags"}, state_value<&AxisState::status_flags>()},
+  {{156, "status flags", 0, status_flag::kAll, 0, access("R"), Unit::kNone, "Status flag bits (docs/tmcm-1636-servo.md)"}, state_value<&AxisState::status_flags>()},
   {{160, "absolute encoder type", 0, 2, 0, access("RWEX"), Unit::kNone, "0 disabled, 1 AMT20, 2 AMT23"}, config_field<&AxisConfig::absolute_encoder_type>()},
   {{161, "absolute encoder init", 0, 1, 0, access("RWEX"), Unit::kNone, "0 estimate offset, 1 use offset"}, config_field<&AxisConfig::absolute_encoder_init>()},
   {{162, "absolute encoder direction", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted"}, config_field<&AxisConfig::absolute_encoder_direction>()},
-  {{163, "absolute encoder offset", 0, 65535, 0, access("RWE"), Unit::kNone, "Commutation offset of the absolute encoder"}, config_field<&AxisConfig::absolute_encoder_offset>()},
+  {{163, "absolute encoder offset", 0, 65535, 0, access("RWE"), Unit::kNone, "Absolute angle at electrical angle 0, 65536 per revolution"}, config_field<&AxisConfig::absolute_encoder_offset>()},
   {{209, "reference switch enable", 0, 3, 0, access("RWX"), Unit::kNone, "Bit 0 right, bit 1 left: 1 = switch stops motion towards it"}, config_field<&AxisConfig::reference_switch_enable>()},
   {{210, "reference switch polarity", 0, 7, 0, access("RWX"), Unit::kNone, "Bit 0 right, 1 left, 2 home: 1 = high active"}, config_field<&AxisConfig::reference_switch_polarity>()},
   {{211, "right reference switch active", 0, 1, 0, access("R"), Unit::kNone, "1 while the right reference switch is active"}, state_value<&AxisState::right_switch_active>()},
@@ -210,6 +244,10 @@ constexpr Row kAxisRows[] = {
 constexpr Row kGlobalRows[] = {
   {{65, "serial baud rate", 0, 7, 7, access("RWA"), Unit::kBaudRateCode, "0 9600, 1 14400, 2 19200, 3 28800, 4 38400, 5 57600, 6 76800, 7 115200 bit/s; no effect on a pseudo-terminal"}, global_field<&GlobalConfig::serial_baud_rate_code>()},
   {{66, "serial address", 1, 255, 1, access("RWAX"), Unit::kAddress, "Module (target) address on RS485, RS232, USB and TCP"}, global_field<&GlobalConfig::serial_address>()},
+  // Motwin extension: the TMCM-1636 manual has no ASCII interface; Motwin gives it the one of
+  // the TMCM-142 (command 139, GP 67 as in its manual 6.6.4) so that terminal users can drive
+  // it (docs/ascii-mode.md). Bits other than 0, 4 and 5 are kept but have no effect.
+  {{67, "ASCII mode", 0, 255, 0, access("RWA"), Unit::kNone, "bit 0 start in ASCII mode; bits 4-5 echo: 00 each character, bit 4 whole line after CR, bit 5 none"}, global_field<&GlobalConfig::ascii_mode>()},
   {{69, "CAN bit rate", 2, 8, 8, access("RWA"), Unit::kBitRateCode, "2 20, 3 50, 4 100, 5 125, 6 250, 7 500, 8 1000 kbit/s"}, global_field<&GlobalConfig::can_bit_rate_code>()},
   {{70, "CAN send ID", 0, 255, 2, access("RWAX"), Unit::kAddress, "CAN identifier of the module's replies"}, global_field<&GlobalConfig::can_send_id>()},
   {{71, "CAN receive ID", 0, 255, 1, access("RWAX"), Unit::kAddress, "CAN identifier the module listens to"}, global_field<&GlobalConfig::can_receive_id>()},

@@ -1,0 +1,113 @@
+// `motwin asm`: assembles a TMCL-IDE `.tmc` program into a `.bin` file (8 bytes per
+// instruction), with an optional listing and symbol file (docs/assembler.md).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "cli/cli_errors.h"
+#include "cli/commands.h"
+#include "tools/tmcl_assembler.h"
+#include "tools/tmcl_binary.h"
+
+namespace motwin::cli {
+namespace {
+
+constexpr int kExitAssemblyError = 1;  // the program has errors; nothing was written
+
+struct AsmOptions {
+  std::string source;
+  std::string output;
+  std::vector<std::string> include_dirs;
+  std::string listing;
+  std::string symbols;
+  size_t program_memory = tools::kDefaultProgramMemorySize;
+};
+
+// "-" writes to stdout.
+bool write_text(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::cout << text << std::flush;
+    return static_cast<bool>(std::cout);
+  }
+  std::ofstream out(path, std::ios::trunc);
+  out << text;
+  out.close();
+  return static_cast<bool>(out);
+}
+
+int run_asm(const AsmOptions& options) {
+  tools::AssemblerOptions assembler_options;
+  assembler_options.include_dirs = options.include_dirs;
+  assembler_options.program_memory_size = options.program_memory;
+  const tools::AssemblyResult result = tools::assemble_file(options.source, assembler_options);
+  if (!result.ok()) {
+    for (const tools::AssemblyError& error : result.errors) std::cerr << tools::format_error(error) << '\n';
+    if (result.errors.front().kind == tools::AssemblyErrorKind::kFileNotFound) return kExitUsageError;
+    print_error(fmt::format("{} error{} in {}; nothing written", result.errors.size(),
+                            result.errors.size() == 1 ? "" : "s", options.source));
+    return kExitAssemblyError;
+  }
+
+  const std::string output = options.output.empty()
+                                 ? std::filesystem::path(options.source).replace_extension(".bin").string()
+                                 : options.output;
+  if (std::filesystem::path(output).lexically_normal() == std::filesystem::path(options.source).lexically_normal()) {
+    print_error(fmt::format("the output {} would overwrite the source; give another name with -o", output));
+    return kExitUsageError;
+  }
+  const tools::Result<size_t> written = tools::write_program_binary(output, result.instructions);
+  if (!written) {
+    print_error(written.error());
+    return kExitUsageError;
+  }
+  if (!options.listing.empty() && !write_text(options.listing, tools::format_listing(result))) {
+    print_error(fmt::format("cannot write the listing to {}", options.listing));
+    return kExitUsageError;
+  }
+  if (!options.symbols.empty() && !write_text(options.symbols, tools::format_symbols(result))) {
+    print_error(fmt::format("cannot write the symbols to {}", options.symbols));
+    return kExitUsageError;
+  }
+  // The summary goes to stderr when stdout carries the listing or the symbols.
+  const bool stdout_taken = options.listing == "-" || options.symbols == "-";
+  (stdout_taken ? std::cerr : std::cout) << fmt::format("{}: {} instructions (STOP appended), {} bytes written to {}\n",
+                                                        options.source, result.instructions.size(), written.value(),
+                                                        output);
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_asm_command(CLI::App& app, int& exit_status) {
+  auto options = std::make_shared<AsmOptions>();
+  CLI::App* command = app.add_subcommand("asm", "Assemble a TMCL-IDE .tmc program into a .bin file");
+  command->add_option("program", options->source, "The .tmc source file")->required();
+  command->add_option("-o,--output", options->output, "The .bin file to write (default: PROGRAM with .bin)");
+  command->add_option("-I,--include-dir", options->include_dirs,
+                      "Directory searched for #include files not found next to the including file (repeatable)");
+  command->add_option("--listing", options->listing,
+                      "Write a listing (address, bytes, source) to FILE, or - for stdout");
+  command->add_option("--symbols", options->symbols,
+                      "Write the labels (addresses for 129 type 1) and constants to FILE, or - for stdout");
+  command->add_option("--program-memory", options->program_memory, "Program memory size in instructions")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 24));
+  command->footer(
+      "Examples:\n"
+      "  motwin asm program.tmc                        (writes program.bin)\n"
+      "  motwin asm program.tmc -o out.bin -I lib --listing - --symbols program.sym\n"
+      "\n"
+      "Syntax: TMCL-IDE (// comments, Name = value, #include File.tmc, Label:, symbolic operands);\n"
+      "a STOP is appended after the last instruction. See docs/assembler.md.\n"
+      "Errors: 'FILE:LINE:COLUMN: error: MESSAGE' on stderr, every error of the program.\n"
+      "Exit status: 0 assembled, 1 the program has errors (nothing written), 2 usage error or\n"
+      "unreadable/unwritable file.\n");
+  command->callback([options, &exit_status] { exit_status = run_asm(*options); });
+}
+
+}  // namespace motwin::cli

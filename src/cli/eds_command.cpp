@@ -1,0 +1,53 @@
+// `motwin eds`: writes the CiA-306 EDS of a CANopen module from its object table.
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "cli/cli_errors.h"
+#include "cli/commands.h"
+#include "tools/eds_writer.h"
+
+namespace motwin::cli {
+
+void add_eds_command(CLI::App& app, int& exit_status) {
+  struct Options {
+    std::string module = "tmcm-3216";
+    int node_id = 0;
+    std::string output;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* eds = app.add_subcommand("eds", "Write the CiA-306 EDS file of a CANopen module (tmcm-3216)");
+  eds->add_option("--module", options->module, "CANopen module")->type_name("NAME")->capture_default_str();
+  eds->add_option("--node-id", options->node_id, "Add a [DeviceComissioning] section with this node ID")
+      ->type_name("N")
+      ->check(CLI::Range(1, 127));
+  eds->add_option("-o,--output", options->output, "Write to FILE instead of stdout")->type_name("FILE");
+  eds->callback([options, &exit_status] {
+    std::optional<uint8_t> node_id;
+    if (options->node_id != 0) node_id = static_cast<uint8_t>(options->node_id);
+    const std::optional<std::string> text = tools::write_module_eds(options->module, node_id);
+    if (!text) {
+      print_error("module \"" + options->module + "\" has no CANopen object dictionary (available: tmcm-3216)");
+      exit_status = kExitUsageError;
+      return;
+    }
+    if (options->output.empty()) {
+      std::cout << *text;
+      exit_status = kExitSuccess;
+      return;
+    }
+    std::ofstream file(options->output, std::ios::binary | std::ios::trunc);
+    file << *text;
+    file.close();
+    if (!file) {
+      print_error("cannot write " + options->output);
+      exit_status = kExitUsageError;
+      return;
+    }
+    exit_status = kExitSuccess;
+  });
+}
+
+}  // namespace motwin::cli

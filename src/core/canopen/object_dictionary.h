@@ -1,0 +1,253 @@
+// The CANopen object dictionary: every object a master can reach by index and sub-index,
+// described as data (DESIGN.md "One declarative source per module"). A module lists its objects
+// as EntryRow tables, one row per sub-index with the manual's columns: index, sub-index, names,
+// data type, access (ro/wo/rw/const), PDO mapping, value range and default. Rows bind to the
+// module's typed state with small function pointers, the way params::ParameterRow does for TMCL.
+//
+// Multi-axis modules (TMCM-3216 manual 2.6.1): a row with axis_stride != 0 describes one object
+// per axis, axis n at index + n * axis_stride (0x200 manufacturer area, 0x800 profile area,
+// 0x40 PDO parameters).
+//
+// The SDO server (and later the PDOs and the EDS writer) reach every object through the one
+// ObjectDictionary interface, as CANopenNode's OD interface does.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <type_traits>
+
+#include "core/canopen/sdo_abort.h"
+
+namespace motwin::canopen {
+
+// CiA-301 data type indices (they are also the EDS DataType values).
+enum class DataType : uint8_t {
+  kBoolean = 0x01,
+  kInteger8 = 0x02,
+  kInteger16 = 0x03,
+  kInteger32 = 0x04,
+  kUnsigned8 = 0x05,
+  kUnsigned16 = 0x06,
+  kUnsigned32 = 0x07,
+  kVisibleString = 0x09,
+};
+
+// Size in bytes of a numeric type; 0 for a visible string (its size is its current length).
+constexpr uint8_t type_size(DataType type) {
+  switch (type) {
+    case DataType::kBoolean:
+    case DataType::kInteger8:
+    case DataType::kUnsigned8: return 1;
+    case DataType::kInteger16:
+    case DataType::kUnsigned16: return 2;
+    case DataType::kInteger32:
+    case DataType::kUnsigned32: return 4;
+    case DataType::kVisibleString: return 0;
+  }
+  return 0;
+}
+constexpr bool is_signed(DataType type) {
+  return type == DataType::kInteger8 || type == DataType::kInteger16 || type == DataType::kInteger32;
+}
+constexpr bool is_numeric(DataType type) { return type_size(type) != 0; }
+
+enum class Access : uint8_t { kRo, kWo, kRw, kConst };
+constexpr bool readable(Access access) { return access != Access::kWo; }
+constexpr bool writable(Access access) { return access == Access::kWo || access == Access::kRw; }
+
+// CiA-306 object codes.
+enum class ObjectCode : uint8_t { kVar = 7, kArray = 8, kRecord = 9 };
+
+// What 1010/1011 sub-indices (and 2706) save and restore. See docs/canopen.md "Storage".
+enum class StorageGroup : uint8_t {
+  kNone,           // not stored (constants, live values, actions)
+  kCommunication,  // 1005..1029, PDO parameters: saved by 1010 sub 1 only
+  kNodeSettings,   // 2704 bit rate, 2705 node ID: 1010 sub 1 and 2, 2706 sub 1
+  kAxis,           // motor n parameters: 1010 sub 1 and sub 4 + n
+};
+
+// One sub-index as the manual's entry-description tables give it. Pure data.
+struct EntryInfo {
+  uint16_t index;
+  uint8_t sub;
+  ObjectCode code;
+  std::string_view object_name;  // name of the index ("Identity Object")
+  std::string_view name;         // name of the sub-index ("Vendor ID"); a VAR repeats object_name
+  DataType type;
+  Access access;
+  bool pdo_mappable;
+  int64_t min;                   // value range of numeric entries (unsigned 32-bit fits)
+  int64_t max;
+  int64_t default_value;
+  bool default_plus_node_id;     // EDS "$NODEID+default": 1014, PDO COB-IDs
+  uint16_t axis_stride;          // 0: one object for the device
+  StorageGroup storage;
+  // nullptr: every axis has default_value; else the default of each axis (PDO mappings of
+  // axis n name the objects of axis n; PDOs of axes 1 and 2 start disabled).
+  int64_t (*axis_default)(uint8_t axis);
+};
+
+// An entry found by index and sub-index: the row, the axis and the index that was asked for.
+struct ObjectRef {
+  const EntryInfo* info = nullptr;
+  size_t row = 0;
+  uint16_t index = 0;
+  uint8_t axis = 0;
+};
+
+class ObjectDictionary {
+ public:
+  // kNoObject when no object has this index, kNoSubIndex when it has no such sub-index.
+  virtual SdoAbort find(uint16_t index, uint8_t sub, ObjectRef& out) const = 0;
+  // Size of the current value in bytes: the type's size, or a string's length.
+  virtual size_t size(const ObjectRef& ref) = 0;
+  // The value as an SDO upload sends it (little-endian); kWriteOnly for a wo entry.
+  virtual SdoAbort read(const ObjectRef& ref, uint8_t* out, size_t capacity, size_t& length) = 0;
+  // A write as an SDO download makes it: access, size (kDataTooLong/kDataTooShort), range
+  // (kValueTooHigh/kValueTooLow) and the object's own checks, then the value is stored.
+  virtual SdoAbort write(const ObjectRef& ref, const uint8_t* data, size_t length) = 0;
+
+ protected:
+  ~ObjectDictionary() = default;
+};
+
+// Little-endian codec of numeric values: two's complement, sign-extended when read back.
+void encode_value(DataType type, int64_t value, uint8_t* out);
+int64_t decode_value(DataType type, const uint8_t* data);
+// kNone, kValueTooHigh or kValueTooLow.
+SdoAbort check_range(const EntryInfo& info, int64_t value);
+// Whether `index` names the object of `info` for some axis below axis_count; sets `axis`.
+bool index_matches(const EntryInfo& info, uint16_t index, uint8_t axis_count, uint8_t& axis);
+
+// How a row reaches the module's state. Owner is the module profile.
+template <class Owner>
+struct EntryBinding {
+  // nullptr: the entry is the row's constant default (plus the node ID where flagged).
+  int64_t (*get)(Owner& owner, uint8_t axis) = nullptr;
+  // Stores a value already checked against the row's range (and `check` for SDO writes). Used
+  // for SDO writes, for loading defaults and stored values at reset, and for actions (1010).
+  SdoAbort (*set)(Owner& owner, uint8_t axis, int64_t value) = nullptr;
+  // Extra checks of an SDO write, without side effects: PDO rules, allowed value sets.
+  SdoAbort (*check)(Owner& owner, uint8_t axis, int64_t value) = nullptr;
+  // Visible strings.
+  std::string_view (*get_string)(Owner& owner, uint8_t axis) = nullptr;
+};
+
+template <class Owner>
+struct EntryRow {
+  EntryInfo info;
+  EntryBinding<Owner> binding;
+};
+
+// A binding to one plain field: `Ref` is a captureless lambda `(Owner&, uint8_t axis) -> T&`.
+template <class Owner, auto Ref>
+constexpr EntryBinding<Owner> field_binding() {
+  EntryBinding<Owner> binding;
+  binding.get = [](Owner& owner, uint8_t axis) { return static_cast<int64_t>(Ref(owner, axis)); };
+  binding.set = [](Owner& owner, uint8_t axis, int64_t value) {
+    auto& field = Ref(owner, axis);
+    field = static_cast<std::remove_reference_t<decltype(field)>>(value);
+    return SdoAbort::kNone;
+  };
+  return binding;
+}
+
+// The dictionary over a module's row table.
+template <class Owner>
+class TableDictionary final : public ObjectDictionary {
+ public:
+  TableDictionary(Owner& owner, std::span<const EntryRow<Owner>> rows, uint8_t axis_count)
+      : owner_(owner), rows_(rows), axis_count_(axis_count) {}
+  TableDictionary(const TableDictionary&) = delete;
+  TableDictionary& operator=(const TableDictionary&) = delete;
+
+  std::span<const EntryRow<Owner>> rows() const { return rows_; }
+  uint8_t axis_count() const { return axis_count_; }
+  // The node ID that "$NODEID+" defaults add.
+  void set_node_id(uint8_t node_id) { node_id_ = node_id; }
+  uint8_t node_id() const { return node_id_; }
+
+  int64_t default_value(const EntryInfo& info, uint8_t axis) const {
+    const int64_t base = info.axis_default != nullptr ? info.axis_default(axis) : info.default_value;
+    return info.default_plus_node_id ? base + node_id_ : base;
+  }
+
+  SdoAbort find(uint16_t index, uint8_t sub, ObjectRef& out) const override {
+    bool index_found = false;
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      uint8_t axis = 0;
+      if (!index_matches(rows_[i].info, index, axis_count_, axis)) continue;
+      index_found = true;
+      if (rows_[i].info.sub != sub) continue;
+      out = ObjectRef{&rows_[i].info, i, index, axis};
+      return SdoAbort::kNone;
+    }
+    return index_found ? SdoAbort::kNoSubIndex : SdoAbort::kNoObject;
+  }
+
+  size_t size(const ObjectRef& ref) override {
+    if (is_numeric(ref.info->type)) return type_size(ref.info->type);
+    const auto& binding = rows_[ref.row].binding;
+    return binding.get_string ? binding.get_string(owner_, ref.axis).size() : 0;
+  }
+
+  SdoAbort read(const ObjectRef& ref, uint8_t* out, size_t capacity, size_t& length) override {
+    length = 0;
+    if (!readable(ref.info->access)) return SdoAbort::kWriteOnly;
+    if (is_numeric(ref.info->type)) {
+      if (capacity < type_size(ref.info->type)) return SdoAbort::kOutOfMemory;
+      encode_value(ref.info->type, value(ref), out);
+      length = type_size(ref.info->type);
+      return SdoAbort::kNone;
+    }
+    const auto& binding = rows_[ref.row].binding;
+    const std::string_view text = binding.get_string ? binding.get_string(owner_, ref.axis) : std::string_view{};
+    if (text.size() > capacity) return SdoAbort::kOutOfMemory;
+    for (size_t i = 0; i < text.size(); ++i) out[i] = static_cast<uint8_t>(text[i]);
+    length = text.size();
+    return SdoAbort::kNone;
+  }
+
+  SdoAbort write(const ObjectRef& ref, const uint8_t* data, size_t length) override {
+    const EntryInfo& info = *ref.info;
+    const auto& binding = rows_[ref.row].binding;
+    if (!writable(info.access) || binding.set == nullptr) return SdoAbort::kReadOnly;
+    if (!is_numeric(info.type)) return SdoAbort::kUnsupportedAccess;  // no writable strings yet
+    if (length > type_size(info.type)) return SdoAbort::kDataTooLong;
+    if (length < type_size(info.type)) return SdoAbort::kDataTooShort;
+    const int64_t new_value = decode_value(info.type, data);
+    if (const SdoAbort abort = check_range(info, new_value); abort != SdoAbort::kNone) return abort;
+    if (binding.check != nullptr) {
+      if (const SdoAbort abort = binding.check(owner_, ref.axis, new_value); abort != SdoAbort::kNone) return abort;
+    }
+    return binding.set(owner_, ref.axis, new_value);
+  }
+
+  // The current value of a numeric entry, whatever its access.
+  int64_t value(const ObjectRef& ref) {
+    const auto& binding = rows_[ref.row].binding;
+    return binding.get ? binding.get(owner_, ref.axis) : default_value(*ref.info, ref.axis);
+  }
+  // Stores without the SDO checks: defaults and stored values at reset.
+  void store(const ObjectRef& ref, int64_t new_value) {
+    const auto& binding = rows_[ref.row].binding;
+    if (binding.set != nullptr) binding.set(owner_, ref.axis, new_value);
+  }
+  // The reference of row `row` for `axis` (axis 0 for device-wide rows).
+  ObjectRef ref(size_t row, uint8_t axis) const {
+    const EntryInfo& info = rows_[row].info;
+    const uint8_t a = info.axis_stride == 0 ? 0 : axis;
+    return ObjectRef{&info, row, static_cast<uint16_t>(info.index + a * info.axis_stride), a};
+  }
+  uint8_t axes_of(const EntryInfo& info) const { return info.axis_stride == 0 ? 1 : axis_count_; }
+
+ private:
+  Owner& owner_;
+  std::span<const EntryRow<Owner>> rows_;
+  uint8_t axis_count_;
+  uint8_t node_id_ = 1;
+};
+
+}  // namespace motwin::canopen

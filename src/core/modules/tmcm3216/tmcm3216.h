@@ -1,0 +1,159 @@
+// The TMCM-3216 with its CANopen firmware V1.04: the communication area of the object dictionary
+// (manual chapter 3), the node ID and bit rate objects 2704..2708 (4.2.62..4.2.66), NMT with
+// boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
+// memory. PDO, SYNC, EMCY, LSS and the CiA-402 drive follow in later issues; the PDO
+// communication and mapping parameters are already here, as data, with the manual's defaults.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "board/can_controller.h"
+#include "board/non_volatile_memory.h"
+#include "core/can/can_frame.h"
+#include "core/canopen/nmt.h"
+#include "core/canopen/object_dictionary.h"
+#include "core/canopen/sdo_server.h"
+#include "core/canopen/storage.h"
+
+namespace motwin::modules::tmcm3216 {
+
+inline constexpr uint8_t kAxisCount = 3;
+inline constexpr uint8_t kPdosPerAxis = 4;       // RPDO/TPDO 1..4, 65..68, 129..132 (manual 1.1)
+inline constexpr uint8_t kMaxMappedObjects = 3;  // "dynamic mapping with max. three mapping entries"
+inline constexpr uint16_t kPdoAxisStride = 0x40; // 1400 -> 1440 -> 1480 (manual 3.1.15)
+// The CANopen services run once per millisecond of simulated time (and at once whenever a frame
+// arrives, so that an SDO request is answered within the process() call that sees it).
+inline constexpr uint32_t kTickUs = 1000;
+
+struct PdoCommunication {
+  uint32_t cob_id;               // sub 1: bit 31 = not valid, bit 30 = no RTR
+  uint8_t transmission_type;     // sub 2: 1..240 synchronous, 254/255 event driven
+  uint16_t inhibit_time_100us;   // sub 3 (TPDO)
+  uint16_t event_timer_ms;       // sub 5 (TPDO)
+};
+
+struct PdoMapping {
+  uint8_t count;                                   // sub 0
+  uint32_t entries[kMaxMappedObjects];             // index << 16 | sub << 8 | bits
+};
+
+// The communication objects a master writes (1005..1029, 1400..1A03 of each axis).
+struct CommunicationConfig {
+  uint32_t sync_cob_id;              // 1005
+  uint32_t emcy_cob_id;              // 1014
+  uint16_t emcy_inhibit_100us;       // 1015
+  uint32_t consumer_heartbeat[1];    // 1016 sub 1
+  uint16_t producer_heartbeat_ms;    // 1017
+  uint8_t error_behavior[2];         // 1029 sub 1, 2
+  PdoCommunication rpdo[kAxisCount][kPdosPerAxis];
+  PdoMapping rpdo_mapping[kAxisCount][kPdosPerAxis];
+  PdoCommunication tpdo[kAxisCount][kPdosPerAxis];
+  PdoMapping tpdo_mapping[kAxisCount][kPdosPerAxis];
+};
+
+// 2704 / 2705: what applies after the next reset (2707 / 2708 show what applies now).
+struct NodeSettings {
+  uint16_t bit_rate_kbit;
+  uint8_t node_id;  // 1..127, 255 = LSS unconfigured
+};
+
+struct Tmcm3216Config {
+  // The module's address switches: 1..127 overrides the stored node ID (2705), as the manual
+  // says switches do (4.2.63); 0 = no switches, 2705 decides.
+  uint8_t node_id_switches = 0;
+  uint32_t serial_number = 0;  // 1018 sub 4
+};
+
+class Tmcm3216 {
+ public:
+  using Dictionary = canopen::TableDictionary<Tmcm3216>;
+  using Row = canopen::EntryRow<Tmcm3216>;
+
+  static constexpr std::string_view kName = "tmcm-3216";
+  static constexpr std::string_view kDeviceName = "TMCM-3216";      // 1008
+  static constexpr std::string_view kHardwareVersion = "1.00";      // 1009 (manual's example)
+  static constexpr std::string_view kSoftwareVersion = "1.04";      // 100A: firmware V1.04
+  static constexpr std::string_view kFirmwareVersion = "CANopen V1.04";
+  // 1000 as table 8 prints it. CiA-301's rule for multi-device modules would give 0xFFFF0192;
+  // the manual is what the real module reports (docs/canopen.md "Decisions").
+  static constexpr uint32_t kDeviceType = 0xFFFC'0192;
+  static constexpr uint32_t kVendorId = 0x0000'0286;
+  static constexpr uint32_t kProductCode = 3216;
+  static constexpr uint32_t kRevisionNumber = 0x0001'0004;  // major << 16 | minor, "20003h for 2.3"
+  static constexpr uint32_t kSaveSignature = 0x6576'6173;   // "save"
+  static constexpr uint32_t kLoadSignature = 0x6461'6F6C;   // "load"
+
+  static constexpr uint32_t kNvmLayoutVersion = 1;
+  static constexpr size_t kNvmRecordCapacity = 1024;
+  static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
+  static constexpr size_t kReceiveQueueLength = 32;
+
+  // Every object of the dictionary (tmcm3216_objects.cpp).
+  static std::span<const Row> object_table();
+  // An image with nothing stored: every object at its default.
+  static void format_factory_image(uint8_t* image, size_t size);
+
+  Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, const Tmcm3216Config& config = {});
+  Tmcm3216(const Tmcm3216&) = delete;
+  Tmcm3216& operator=(const Tmcm3216&) = delete;
+
+  // Power-on: every object from the NVM (or its default), boot-up message, pre-operational.
+  void power_up();
+  // A frame from the bus (the CAN receive interrupt): queued for the next process() call.
+  // false: the queue was full and the frame is lost.
+  bool receive(const can::CanFrame& frame);
+  // Handles the queued frames, then advances the services' timers by `elapsed_us`.
+  void process(uint32_t elapsed_us);
+  void tick() { process(kTickUs); }
+
+  uint8_t node_id() const { return node_id_; }            // active (2708)
+  uint16_t bit_rate_kbit() const { return bit_rate_kbit_; }  // active (2707)
+  bool configured() const { return node_id_ >= 1 && node_id_ <= 127; }
+  canopen::NmtState nmt_state() const { return nmt_.state(); }
+  uint8_t error_register() const { return error_register_; }
+  uint64_t dropped_frames() const { return dropped_frames_; }
+
+  Dictionary& dictionary() { return dictionary_; }
+  canopen::NmtSlave& nmt() { return nmt_; }
+  canopen::SdoServer& sdo() { return sdo_; }
+  CommunicationConfig& communication() { return communication_; }
+  NodeSettings& node_settings() { return node_settings_; }
+  const Tmcm3216Config& config() const { return config_; }
+
+  // 1010 / 1011 / 2706 sub-index `sub` written with `signature`.
+  canopen::SdoAbort store_parameters(uint8_t sub, uint32_t signature);
+  canopen::SdoAbort restore_parameters(uint8_t sub, uint32_t signature);
+  canopen::SdoAbort store_node_settings(uint32_t signature);
+
+ private:
+  void reset_node();
+  void reset_communication();
+  void handle_frame(const can::CanFrame& frame);
+  void run_nmt(uint32_t elapsed_us);
+
+  board::NonVolatileMemory& nvm_;
+  board::CanController& can_;
+  Tmcm3216Config config_;
+  CommunicationConfig communication_{};
+  NodeSettings node_settings_{};
+  uint8_t node_id_ = 1;
+  uint16_t bit_rate_kbit_ = 1000;
+  uint8_t error_register_ = 0;
+
+  Dictionary dictionary_;
+  canopen::NmtSlave nmt_;
+  canopen::SdoServer sdo_;
+  std::array<uint8_t, kNvmSize> storage_scratch_{};
+  canopen::ObjectStorage<Tmcm3216> storage_;
+
+  std::array<can::CanFrame, kReceiveQueueLength> receive_queue_{};
+  size_t receive_head_ = 0;
+  size_t receive_count_ = 0;
+  uint64_t dropped_frames_ = 0;
+};
+
+}  // namespace motwin::modules::tmcm3216

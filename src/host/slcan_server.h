@@ -1,0 +1,53 @@
+// SLCAN over TCP on the virtual CAN bus: each TCP client is a Lawicel adapter of its own
+// (host/slcan_protocol.h), as python-can reaches it with `interface='slcan',
+// channel='socket://127.0.0.1:PORT'` (a pyserial URL). A client sees the bus's frames while its
+// channel is open (`O`), never its own.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "host/can_bus.h"
+#include "host/eeprom_file.h"
+#include "host/event_loop.h"
+#include "host/tcp_server.h"
+
+namespace motwin::host {
+
+class SlcanTcpServer {
+ public:
+  static constexpr size_t kMaxClients = 64;
+  static constexpr size_t kMaxPendingOutputBytes = 1024 * 1024;
+
+  struct OpenResult {
+    std::unique_ptr<SlcanTcpServer> server;
+    std::string error;
+  };
+  static OpenResult open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec, LogSink log = log_to_stderr);
+
+  SlcanTcpServer(const SlcanTcpServer&) = delete;
+  SlcanTcpServer& operator=(const SlcanTcpServer&) = delete;
+  ~SlcanTcpServer();
+
+  std::string local_address() const;
+  uint16_t local_port() const;
+  size_t client_count() const { return connections_.size(); }
+
+ private:
+  class Connection;
+  SlcanTcpServer(EventLoop& loop, CanBus& bus, int listen_fd, LogSink log);
+  void accept_clients();
+  void close_connection(Connection& connection, const std::string& reason);
+
+  EventLoop& loop_;
+  CanBus& bus_;
+  int listen_fd_;
+  LogSink log_;
+  uint64_t next_connection_id_ = 1;
+  std::map<uint64_t, std::shared_ptr<Connection>> connections_;
+};
+
+}  // namespace motwin::host

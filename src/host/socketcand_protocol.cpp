@@ -1,0 +1,121 @@
+#include "host/socketcand_protocol.h"
+
+#include <charconv>
+#include <cstdio>
+
+namespace motwin::host {
+namespace {
+
+bool parse_hex(std::string_view text, uint32_t& value) {
+  if (text.empty() || text.size() > 8) return false;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value, 16);
+  return result.ec == std::errc{} && result.ptr == text.data() + text.size();
+}
+
+}  // namespace
+
+void SocketcandElementParser::push(std::string_view bytes, std::vector<std::string>& out) {
+  for (const char c : bytes) {
+    switch (state_) {
+      case State::kOutside:
+        if (c == '<') {
+          element_.clear();
+          state_ = State::kInside;
+        }
+        break;
+      case State::kInside:
+        if (c == '<') {
+          ++dropped_;
+          element_.clear();
+        } else if (c == '>') {
+          out.push_back(element_);
+          element_.clear();
+          state_ = State::kOutside;
+        } else if (element_.size() >= kMaxElementLength) {
+          ++dropped_;
+          element_.clear();
+          state_ = State::kSkipping;
+        } else {
+          element_.push_back(c);
+        }
+        break;
+      case State::kSkipping:
+        if (c == '<') {
+          element_.clear();
+          state_ = State::kInside;
+        } else if (c == '>') {
+          state_ = State::kOutside;
+        }
+        break;
+    }
+  }
+}
+
+std::vector<std::string_view> socketcand_words(std::string_view element) {
+  std::vector<std::string_view> words;
+  size_t i = 0;
+  while (i < element.size()) {
+    while (i < element.size() && (element[i] == ' ' || element[i] == '\t' || element[i] == '\r' || element[i] == '\n')) {
+      ++i;
+    }
+    const size_t start = i;
+    while (i < element.size() && element[i] != ' ' && element[i] != '\t' && element[i] != '\r' && element[i] != '\n') {
+      ++i;
+    }
+    if (i > start) words.push_back(element.substr(start, i - start));
+  }
+  return words;
+}
+
+std::optional<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words, std::string& error) {
+  if (words.size() < 3 || words[0] != "send") {
+    error = "send needs an ID and a length";
+    return std::nullopt;
+  }
+  can::CanFrame frame;
+  uint32_t id = 0;
+  if (!parse_hex(words[1], id) || id > can::kMaxExtendedId) {
+    error = "bad CAN ID";
+    return std::nullopt;
+  }
+  frame.id = id;
+  frame.extended = words[1].size() == 8 || id > can::kMaxStandardId;
+  uint32_t length = 0;
+  if (!parse_hex(words[2], length) || length > can::kMaxDataLength) {
+    error = "bad length";
+    return std::nullopt;
+  }
+  if (words.size() != 3 + length) {
+    error = "length does not match the data";
+    return std::nullopt;
+  }
+  frame.dlc = static_cast<uint8_t>(length);
+  for (uint32_t i = 0; i < length; ++i) {
+    uint32_t byte = 0;
+    if (words[3 + i].size() > 2 || !parse_hex(words[3 + i], byte)) {
+      error = "bad data byte";
+      return std::nullopt;
+    }
+    frame.data[i] = static_cast<uint8_t>(byte);
+  }
+  return frame;
+}
+
+std::string format_socketcand_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
+  char head[64];
+  std::snprintf(head, sizeof(head), frame.extended ? " < frame %08X %llu.%06llu " : " < frame %03X %llu.%06llu ",
+                static_cast<unsigned>(frame.id), static_cast<unsigned long long>(timestamp_us / 1'000'000u),
+                static_cast<unsigned long long>(timestamp_us % 1'000'000u));
+  std::string text = head;
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  if (!frame.rtr) {
+    for (uint8_t i = 0; i < frame.dlc && i < can::kMaxDataLength; ++i) {
+      text.push_back(kHex[frame.data[i] >> 4]);
+      text.push_back(kHex[frame.data[i] & 0x0F]);
+    }
+  }
+  text += " >";
+  return text;
+}
+
+}  // namespace motwin::host

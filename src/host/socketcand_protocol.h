@@ -1,0 +1,52 @@
+// The socketcand ASCII protocol, as python-can 4.1.0's `socketcand` interface speaks it
+// (notes/canopen.md): elements `< ... >` with no line terminator, `< send ID LEN B0 B1 ... >`
+// from the client, `< frame ID SEC.USEC HEXDATA >` to it. Pure text handling, no sockets.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/can/can_frame.h"
+
+namespace motwin::host {
+
+// Splits a byte stream into elements. Text outside `< >` is ignored; a `<` inside an element
+// starts a new one (the broken one is dropped); an element longer than kMaxElementLength is
+// dropped up to the next `<`. Garbage never stops the stream.
+class SocketcandElementParser {
+ public:
+  static constexpr size_t kMaxElementLength = 256;
+
+  // Appends each complete element's inner text (between `<` and `>`) to `out`.
+  void push(std::string_view bytes, std::vector<std::string>& out);
+  size_t dropped_elements() const { return dropped_; }
+
+ private:
+  enum class State : uint8_t { kOutside, kInside, kSkipping };
+  State state_ = State::kOutside;
+  std::string element_;
+  size_t dropped_ = 0;
+};
+
+// Whitespace-separated words of an element ("send 601 8 40 0 10 0 0 0 0 0").
+std::vector<std::string_view> socketcand_words(std::string_view element);
+
+// `send ID LEN [B]*` words (with "send" first) into a frame. ID in hex; extended when written with
+// 8 digits or above 0x7FF. LEN 0..8; exactly LEN data words of 1 or 2 hex digits, any case.
+// nullopt with `error` set otherwise.
+std::optional<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words, std::string& error);
+
+// ` < frame ID SEC.USEC HEXDATA >` with ID as %03X or %08X and the data as one uppercase hex
+// string; an empty frame has two spaces before `>`. The space between two frames is deliberate:
+// python-can 4.1.0 drops the character after the last complete element of each read, and when a
+// read ends inside the next frame that character is this space instead of its `<` (which would
+// lose the frame). The space goes before each frame rather than after it: a read that ends with a
+// frame then leaves nothing behind, where a trailing space makes python-can log "Bad data: No
+// opening < found" for every read (docs/canopen.md).
+std::string format_socketcand_frame(const can::CanFrame& frame, uint64_t timestamp_us);
+
+}  // namespace motwin::host

@@ -1,0 +1,85 @@
+#include "host/tmcm3216_virtual_module.h"
+
+#include <cstdlib>
+
+namespace motwin::host {
+
+EepromImageIdentity Tmcm3216VirtualModule::eeprom_identity() {
+  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, Device::kNvmSize};
+}
+
+std::span<const sim::SignalInfo> Tmcm3216VirtualModule::signal_table() { return {}; }
+
+MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
+  MakeModuleResult result;
+  if (options.node_id > 127) {
+    result.error = "node ID " + std::to_string(options.node_id) + " is out of range (1..127)";
+    return result;
+  }
+  std::unique_ptr<Tmcm3216VirtualModule> module(new Tmcm3216VirtualModule());
+  if (options.state_dir) {
+    EepromFile::OpenResult opened =
+        EepromFile::open(*options.state_dir, eeprom_identity(), &Device::format_factory_image, options.log);
+    if (!opened.file) {
+      result.error = opened.error;
+      return result;
+    }
+    module->eeprom_file_ = std::move(opened.file);
+    module->nvm_ = module->eeprom_file_.get();
+  } else {
+    module->memory_image_ = std::make_unique<MemoryImage>();
+    Device::format_factory_image(module->memory_image_->mutable_data(), module->memory_image_->size());
+    module->nvm_ = module->memory_image_.get();
+  }
+  modules::tmcm3216::Tmcm3216Config config;
+  config.node_id_switches = options.node_id;
+  config.serial_number = 1;
+  board::CanController& controller = *module;  // private base: reachable here only
+  module->device_ = std::make_unique<Device>(*module->nvm_, controller, config);
+  // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a
+  // master joins later. Masters send an NMT reset to see one (docs/canopen.md).
+  module->device_->power_up();
+  result.module = std::move(module);
+  return result;
+}
+
+Tmcm3216VirtualModule::~Tmcm3216VirtualModule() { disconnect(); }
+
+tmcl::TmclEngine& Tmcm3216VirtualModule::engine() { std::abort(); }
+
+void Tmcm3216VirtualModule::run_ticks(uint64_t count) {
+  for (uint64_t i = 0; i < count; ++i) {
+    device_->tick();
+    ++tick_count_;
+  }
+}
+
+std::string Tmcm3216VirtualModule::nvm_location() const {
+  return eeprom_file_ ? eeprom_file_->path().string() : "none";
+}
+
+void Tmcm3216VirtualModule::connect(CanBus& bus) {
+  disconnect();
+  bus_ = &bus;
+  bus_id_ = bus.attach(*this);
+}
+
+void Tmcm3216VirtualModule::disconnect() {
+  if (bus_ != nullptr) bus_->detach(bus_id_);
+  bus_ = nullptr;
+  bus_id_ = 0;
+}
+
+void Tmcm3216VirtualModule::on_frame(const can::CanFrame& frame, uint64_t /*timestamp_us*/) {
+  // The receive interrupt queues the frame; processing it at once (no simulated time passes)
+  // answers an SDO request within the same bus delivery.
+  device_->receive(frame);
+  device_->process(0);
+}
+
+bool Tmcm3216VirtualModule::transmit(const can::CanFrame& frame) {
+  if (bus_ != nullptr) bus_->send(bus_id_, frame);
+  return true;
+}
+
+}  // namespace motwin::host

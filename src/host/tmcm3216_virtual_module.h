@@ -1,0 +1,77 @@
+// The TMCM-3216 (CANopen firmware V1.04) as a virtual module: the module profile with its CAN
+// controller on a virtual bus (host/can_bus.h) and its NVM image in a file or in memory. It has
+// no TMCL interface and, until the CiA-402 drive issue, no motors or I/O signals.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "board/can_controller.h"
+#include "board/ram_non_volatile_memory.h"
+#include "core/modules/tmcm3216/tmcm3216.h"
+#include "host/can_bus.h"
+#include "host/eeprom_file.h"
+#include "host/module_registry.h"
+#include "host/virtual_module.h"
+#include "sim/signals.h"
+
+namespace motwin::host {
+
+class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, private board::CanController {
+ public:
+  using Device = modules::tmcm3216::Tmcm3216;
+  using MemoryImage = board::RamNonVolatileMemory<Device::kNvmSize>;
+
+  static EepromImageIdentity eeprom_identity();
+  static std::span<const sim::SignalInfo> signal_table();
+  static MakeModuleResult make(const ModuleOptions& options);
+
+  Tmcm3216VirtualModule(const Tmcm3216VirtualModule&) = delete;
+  Tmcm3216VirtualModule& operator=(const Tmcm3216VirtualModule&) = delete;
+  ~Tmcm3216VirtualModule() override;
+
+  // VirtualModule.
+  std::string_view name() const override { return Device::kName; }
+  std::string_view firmware_version() const override { return Device::kFirmwareVersion; }
+  [[noreturn]] tmcl::TmclEngine& engine() override;  // never called: has_tmcl() is false
+  bool has_tmcl() const override { return false; }
+  CanBusNode* can_node() override { return this; }
+  uint32_t tick_period_us() const override { return modules::tmcm3216::kTickUs; }
+  void run_ticks(uint64_t count) override;
+  uint64_t tick_count() const override { return tick_count_; }
+  board::NonVolatileMemory& nvm() override { return *nvm_; }
+  std::string nvm_location() const override;
+  sim::SignalBoard& signals() override { return signals_; }
+
+  // CanBusNode.
+  void connect(CanBus& bus) override;
+  void disconnect() override;
+  void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override;
+
+  Device& device() { return *device_; }
+
+ private:
+  // No inputs or outputs yet (the drive issue brings switches, encoders and I/O).
+  class NoSignals final : public sim::SignalBoard {
+   public:
+    std::span<const sim::SignalInfo> input_signals() const override { return {}; }
+    void set_input(std::string_view, double) override {}
+    std::optional<double> read_signal(std::string_view) const override { return std::nullopt; }
+    void take_output_changes(std::vector<sim::OutputChange>&) override {}
+  };
+
+  Tmcm3216VirtualModule() = default;
+  // board::CanController: what the firmware transmits goes onto the bus.
+  bool transmit(const can::CanFrame& frame) override;
+
+  NoSignals signals_;
+  std::unique_ptr<EepromFile> eeprom_file_;
+  std::unique_ptr<MemoryImage> memory_image_;
+  board::NonVolatileMemory* nvm_ = nullptr;
+  std::unique_ptr<Device> device_;
+  CanBus* bus_ = nullptr;
+  CanBus::EndpointId bus_id_ = 0;
+  uint64_t tick_count_ = 0;
+};
+
+}  // namespace motwin::host

@@ -1,0 +1,412 @@
+#include "sim/motor_description.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/modules/tmcm1636/tmcm1636.h"
+
+namespace motwin::sim {
+namespace {
+
+using Json = nlohmann::json;
+using OrderedJson = nlohmann::ordered_json;
+
+// Start-up settings shared by the BLDC presets: three-phase BLDC, hall commutation (works at
+// once, no initialisation), position and velocity from the ABN encoder, hall interpolation on,
+// "use hall" as the encoder initialisation when a host selects ABN commutation (SAP 15, 0, 3).
+MotorDescription default_24v() {
+  MotorDescription m;
+  m.name = "default-24v";
+  m.source =
+      "42 mm 24 V BLDC motor with 4 pole pairs, hall sensors and a 1024-line (4096-count) ABN "
+      "encoder, modelled on the datasheet of the Trinamic QBL4208-61-04-013 (line-to-line 0.8 ohm "
+      "and 1.2 mH, torque constant 0.035 N m/A, rotor inertia 48 g cm^2), the motor of the "
+      "TMCM-1636 examples in PyTrinamic; friction chosen for a no-load current of about 0.3 A at "
+      "4000 rpm";
+  m.kind = MotorKind::kBldc;
+  m.pole_pairs = 4;
+  m.resistance_ohm = 0.4;
+  m.inductance_d_h = 0.6e-3;
+  m.inductance_q_h = 0.6e-3;
+  m.flux_linkage_wb = 0.035 / (1.5 * 4);
+  m.rotor_inertia_kgm2 = 4.8e-6;
+  m.viscous_friction_nm_s = 1.5e-5;
+  m.coulomb_friction_nm = 0.004;
+  m.initial_angle_deg = 40.0;
+  m.abn = {true, 4096, 200.0, false};
+  m.supply = {24.0, 0.1, 470e-6, 10.0, false};
+  m.startup_parameters = {
+      {10, 4},     {11, 2000}, {12, 1000}, {14, 3},    {15, 2},  {25, 1},  {70, 461}, {71, 3932},
+      {72, 1200},  {73, 1200}, {74, 300},  {92, 1},    {100, 4096}, {102, 2},
+  };
+  return m;
+}
+
+MotorDescription large_48v() {
+  MotorDescription m;
+  m.name = "large-48v";
+  m.source =
+      "63 mm outrunner class (ODrive's D5065-270KV): 7 pole pairs, 0.039 ohm and 15.7 uH per "
+      "phase, KV 270 rpm/V (torque constant 8.27/KV = 0.0306 N m/A), inertia 1e-4 kg m^2 "
+      "(notes/motion-models.md); hall sensors and an 8192-count ABN encoder (AMT102 at 2048 "
+      "lines); friction chosen";
+  m.kind = MotorKind::kBldc;
+  m.pole_pairs = 7;
+  m.resistance_ohm = 0.039;
+  m.inductance_d_h = 15.7e-6;
+  m.inductance_q_h = 15.7e-6;
+  m.flux_linkage_wb = (8.27 / 270.0) / (1.5 * 7);
+  m.rotor_inertia_kgm2 = 1e-4;
+  m.viscous_friction_nm_s = 5e-5;
+  m.coulomb_friction_nm = 0.01;
+  m.initial_angle_deg = 17.0;
+  m.abn = {true, 8192, 0.0, false};
+  m.supply = {48.0, 0.05, 1000e-6, 5.0, false};
+  m.startup_parameters = {
+      {10, 7},   {11, 10000}, {12, 3000}, {14, 3},  {15, 2},    {25, 1},   {70, 20},  {71, 639},
+      {72, 13100}, {73, 6300}, {74, 56},  {92, 1},  {100, 8192}, {102, 2}, {141, 520},
+  };
+  return m;
+}
+
+MotorDescription dc_24v() {
+  MotorDescription m;
+  m.name = "dc-24v";
+  m.source =
+      "generic 24 V brushed DC motor of about 60 W with a 512-line (2048-count) ABN encoder; "
+      "values chosen to be typical (terminal resistance 2 ohm, 1 mH, 0.05 N m/A), not taken from "
+      "one datasheet";
+  m.kind = MotorKind::kDc;
+  m.pole_pairs = 1;
+  m.resistance_ohm = 2.0;
+  m.inductance_d_h = 1e-3;
+  m.inductance_q_h = 1e-3;
+  m.flux_linkage_wb = 0.0;
+  m.torque_constant_nm_per_a = 0.05;
+  m.rotor_inertia_kgm2 = 1.5e-5;
+  m.viscous_friction_nm_s = 2e-6;
+  m.coulomb_friction_nm = 0.005;
+  m.initial_angle_deg = 0.0;
+  m.hall.present = false;
+  m.abn = {true, 2048, 90.0, false};
+  m.supply = {24.0, 0.1, 470e-6, 10.0, false};
+  m.startup_parameters = {
+      {10, 1},  {11, 2000}, {14, 1},  {15, 3},  {25, 1},  {70, 768}, {71, 19660},
+      {72, 1200}, {73, 580}, {74, 225}, {100, 2048},
+  };
+  return m;
+}
+
+struct Reader {
+  const Json& object;
+  std::string path;
+  std::string& error;
+  std::set<std::string> seen{};
+
+  bool ok() const { return error.empty(); }
+  void fail(const std::string& what) {
+    if (error.empty()) error = what;
+  }
+  const Json* find(const char* key) {
+    seen.insert(key);
+    const auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+  }
+  std::string where(const char* key) const { return path.empty() ? key : path + "." + key; }
+  void number(const char* key, double& out, double min, double max) {
+    const Json* value = find(key);
+    if (value == nullptr) return;
+    if (!value->is_number()) return fail(where(key) + " must be a number");
+    const double v = value->get<double>();
+    if (!std::isfinite(v) || v < min || v > max) {
+      std::ostringstream text;
+      text << where(key) << " must be from " << min << " to " << max << ", got " << v;
+      return fail(text.str());
+    }
+    out = v;
+  }
+  void integer(const char* key, int& out, int min, int max) {
+    double v = out;
+    number(key, v, min, max);
+    if (std::floor(v) != v) return fail(where(key) + " must be a whole number");
+    out = static_cast<int>(v);
+  }
+  void flag(const char* key, bool& out) {
+    const Json* value = find(key);
+    if (value == nullptr) return;
+    if (!value->is_boolean()) return fail(where(key) + " must be true or false");
+    out = value->get<bool>();
+  }
+  void text(const char* key, std::string& out) {
+    const Json* value = find(key);
+    if (value == nullptr) return;
+    if (!value->is_string()) return fail(where(key) + " must be a string");
+    out = value->get<std::string>();
+  }
+  // Every key must be known: a misspelt key would otherwise be silently ignored.
+  void finish() {
+    for (const auto& [key, value] : object.items()) {
+      if (seen.count(key) == 0) return fail("unknown key " + (path.empty() ? key : path + "." + key));
+    }
+  }
+};
+
+void read_section(Reader& parent, const char* key, const std::function<void(Reader&)>& body) {
+  const Json* section = parent.find(key);
+  if (section == nullptr || !parent.ok()) return;
+  if (!section->is_object()) return parent.fail(parent.where(key) + " must be an object");
+  Reader reader{*section, parent.where(key), parent.error};
+  body(reader);
+  if (reader.ok()) reader.finish();
+}
+
+// The axis parameters must exist, be stored in the EEPROM (E) and be in range.
+std::string check_startup_parameter(int number, int64_t value) {
+  using modules::tmcm1636::Tmcm1636;
+  const auto* row = number >= 0 && number <= 255 ? Tmcm1636::axis_parameters().find(static_cast<uint16_t>(number)) : nullptr;
+  if (row == nullptr) return "axis parameter " + std::to_string(number) + " does not exist";
+  if (!params::has(row->info.access, params::Access::kEeprom)) {
+    return "axis parameter " + std::to_string(number) + " is not stored in the EEPROM";
+  }
+  if (value < row->info.min || value > row->info.max) {
+    return "axis parameter " + std::to_string(number) + " takes " + std::to_string(row->info.min) + " to " +
+           std::to_string(row->info.max) + ", got " + std::to_string(value);
+  }
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string_view> motor_preset_names() { return {"default-24v", "large-48v", "dc-24v"}; }
+
+std::optional<MotorDescription> motor_preset(std::string_view name) {
+  if (name == "default-24v") return default_24v();
+  if (name == "large-48v") return large_48v();
+  if (name == "dc-24v") return dc_24v();
+  return std::nullopt;
+}
+
+MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name) {
+  MotorLoadResult result;
+  const std::string prefix = std::string(source_name) + ": ";
+  Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
+  if (document.is_discarded()) {
+    result.error = prefix + "not valid JSON";
+    return result;
+  }
+  if (!document.is_object()) {
+    result.error = prefix + "expected a JSON object";
+    return result;
+  }
+  MotorDescription m;
+  m.startup_parameters.clear();
+  std::string error;
+  Reader top{document, "", error};
+  top.text("name", m.name);
+  top.text("source", m.source);
+  std::string kind = "bldc";
+  top.text("type", kind);
+  if (kind == "dc") {
+    m.kind = MotorKind::kDc;
+    m.hall.present = false;
+  } else if (kind != "bldc") {
+    top.fail("type must be \"bldc\" or \"dc\", got \"" + kind + "\"");
+  }
+  top.integer("pole_pairs", m.pole_pairs, 1, 255);
+  top.number("resistance_ohm", m.resistance_ohm, 1e-4, 1000.0);
+  double inductance = -1.0;
+  top.number("inductance_h", inductance, 1e-7, 1.0);
+  if (inductance > 0.0) m.inductance_d_h = m.inductance_q_h = inductance;
+  top.number("inductance_d_h", m.inductance_d_h, 1e-7, 1.0);
+  top.number("inductance_q_h", m.inductance_q_h, 1e-7, 1.0);
+  // The magnet strength, in whichever form the datasheet gives it.
+  double flux = -1.0;
+  double kt = -1.0;
+  double kv = -1.0;
+  top.number("flux_linkage_wb", flux, 1e-6, 10.0);
+  top.number("torque_constant_nm_per_a", kt, 1e-5, 100.0);
+  top.number("kv_rpm_per_v", kv, 0.1, 1e5);
+  if (m.kind == MotorKind::kDc) {
+    if (kt <= 0.0) top.fail("a DC motor needs torque_constant_nm_per_a");
+    m.torque_constant_nm_per_a = kt;
+    m.pole_pairs = 1;
+  } else if (flux > 0.0) {
+    m.flux_linkage_wb = flux;
+  } else if (kt > 0.0) {
+    m.flux_linkage_wb = kt / (1.5 * m.pole_pairs);
+  } else if (kv > 0.0) {
+    m.flux_linkage_wb = (8.27 / kv) / (1.5 * m.pole_pairs);  // Kt = 8.27 / KV (ODrive, moteus)
+  } else {
+    top.fail("give one of flux_linkage_wb, torque_constant_nm_per_a or kv_rpm_per_v");
+  }
+  top.number("rotor_inertia_kgm2", m.rotor_inertia_kgm2, 1e-9, 100.0);
+  top.number("viscous_friction_nm_s", m.viscous_friction_nm_s, 0.0, 100.0);
+  top.number("coulomb_friction_nm", m.coulomb_friction_nm, 0.0, 1000.0);
+  top.number("initial_angle_deg", m.initial_angle_deg, -360.0, 360.0);
+  read_section(top, "hall", [&](Reader& r) {
+    m.hall.present = true;
+    r.flag("present", m.hall.present);
+    r.number("offset_deg", m.hall.offset_deg, -360.0, 360.0);
+    r.flag("inverted", m.hall.inverted);
+    r.flag("reversed", m.hall.reversed);
+  });
+  read_section(top, "abn_encoder", [&](Reader& r) {
+    m.abn.present = true;
+    r.flag("present", m.abn.present);
+    int counts = m.abn.counts_per_rev;
+    r.integer("counts_per_rev", counts, 4, 16777215);
+    m.abn.counts_per_rev = counts;
+    r.number("index_deg", m.abn.index_deg, -360.0, 360.0);
+    r.flag("reversed", m.abn.reversed);
+  });
+  read_section(top, "absolute_encoder", [&](Reader& r) {
+    m.absolute.present = true;
+    r.flag("present", m.absolute.present);
+    r.integer("bits", m.absolute.bits, 8, 16);
+    r.number("offset_deg", m.absolute.offset_deg, -360.0, 360.0);
+    r.flag("reversed", m.absolute.reversed);
+  });
+  read_section(top, "brake", [&](Reader& r) {
+    m.brake.present = true;
+    r.flag("present", m.brake.present);
+    r.number("holding_torque_nm", m.brake.holding_torque_nm, 0.0, 1000.0);
+    r.number("pull_in_duty_percent", m.brake.pull_in_duty_percent, 0.0, 100.0);
+    r.number("drop_out_duty_percent", m.brake.drop_out_duty_percent, 0.0, 100.0);
+    r.number("time_constant_s", m.brake.time_constant_s, 1e-4, 10.0);
+  });
+  read_section(top, "supply", [&](Reader& r) {
+    r.number("voltage_v", m.supply.voltage_v, 0.0, 100.0);
+    r.number("source_resistance_ohm", m.supply.source_resistance_ohm, 1e-3, 100.0);
+    r.number("capacitance_f", m.supply.capacitance_f, 1e-6, 10.0);
+    r.number("brake_resistor_ohm", m.supply.brake_resistor_ohm, 0.1, 1e4);
+    r.flag("regenerative", m.supply.regenerative);
+  });
+  if (const Json* parameters = top.find("axis_parameters"); parameters != nullptr && top.ok()) {
+    if (!parameters->is_object()) {
+      top.fail("axis_parameters must be an object of \"number\": value");
+    } else {
+      for (const auto& [key, value] : parameters->items()) {
+        int number = -1;
+        try {
+          size_t used = 0;
+          number = std::stoi(key, &used);
+          if (used != key.size()) number = -1;
+        } catch (const std::exception&) {
+          number = -1;
+        }
+        if (number < 0) {
+          top.fail("axis_parameters: \"" + key + "\" is not a parameter number");
+          break;
+        }
+        if (!value.is_number_integer()) {
+          top.fail("axis_parameters." + key + " must be a whole number");
+          break;
+        }
+        const int64_t v = value.get<int64_t>();
+        if (std::string problem = check_startup_parameter(number, v); !problem.empty()) {
+          top.fail("axis_parameters: " + problem);
+          break;
+        }
+        m.startup_parameters.emplace_back(static_cast<uint8_t>(number), static_cast<int32_t>(v));
+      }
+    }
+  }
+  if (top.ok()) top.finish();
+  if (!error.empty()) {
+    result.error = prefix + error;
+    return result;
+  }
+  if (m.name.empty()) m.name = std::string(source_name);
+  result.motor = std::move(m);
+  return result;
+}
+
+MotorLoadResult load_motor_description_file(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) {
+    MotorLoadResult result;
+    result.error = "cannot read motor description " + path;
+    return result;
+  }
+  std::stringstream contents;
+  contents << file.rdbuf();
+  return parse_motor_description(contents.str(), path);
+}
+
+MotorLoadResult resolve_motor(std::string_view name_or_path) {
+  MotorLoadResult result;
+  if (name_or_path.empty() || name_or_path == "ideal") return result;
+  if (std::optional<MotorDescription> preset = motor_preset(name_or_path)) {
+    result.motor = std::move(preset);
+    return result;
+  }
+  if (name_or_path.find('/') == std::string_view::npos && name_or_path.find('.') == std::string_view::npos) {
+    std::string names = "ideal";
+    for (std::string_view preset_name : motor_preset_names()) names += ", " + std::string(preset_name);
+    result.error = "unknown motor \"" + std::string(name_or_path) + "\" (expected " + names + " or a .json file)";
+    return result;
+  }
+  return load_motor_description_file(std::string(name_or_path));
+}
+
+std::string motor_description_json(const MotorDescription& m) {
+  OrderedJson j;
+  j["name"] = m.name;
+  j["source"] = m.source;
+  j["type"] = m.kind == MotorKind::kDc ? "dc" : "bldc";
+  if (m.kind == MotorKind::kBldc) {
+    j["pole_pairs"] = m.pole_pairs;
+    j["flux_linkage_wb"] = m.flux_linkage_wb;
+  } else {
+    j["torque_constant_nm_per_a"] = m.torque_constant_nm_per_a;
+  }
+  j["resistance_ohm"] = m.resistance_ohm;
+  j["inductance_d_h"] = m.inductance_d_h;
+  j["inductance_q_h"] = m.inductance_q_h;
+  j["rotor_inertia_kgm2"] = m.rotor_inertia_kgm2;
+  j["viscous_friction_nm_s"] = m.viscous_friction_nm_s;
+  j["coulomb_friction_nm"] = m.coulomb_friction_nm;
+  j["initial_angle_deg"] = m.initial_angle_deg;
+  j["hall"] = {{"present", m.hall.present}, {"offset_deg", m.hall.offset_deg}, {"inverted", m.hall.inverted},
+               {"reversed", m.hall.reversed}};
+  j["abn_encoder"] = {{"present", m.abn.present}, {"counts_per_rev", m.abn.counts_per_rev},
+                      {"index_deg", m.abn.index_deg}, {"reversed", m.abn.reversed}};
+  j["absolute_encoder"] = {{"present", m.absolute.present}, {"bits", m.absolute.bits},
+                           {"offset_deg", m.absolute.offset_deg}, {"reversed", m.absolute.reversed}};
+  j["brake"] = {{"present", m.brake.present},
+                {"holding_torque_nm", m.brake.holding_torque_nm},
+                {"pull_in_duty_percent", m.brake.pull_in_duty_percent},
+                {"drop_out_duty_percent", m.brake.drop_out_duty_percent},
+                {"time_constant_s", m.brake.time_constant_s}};
+  j["supply"] = {{"voltage_v", m.supply.voltage_v},
+                 {"source_resistance_ohm", m.supply.source_resistance_ohm},
+                 {"capacitance_f", m.supply.capacitance_f},
+                 {"brake_resistor_ohm", m.supply.brake_resistor_ohm},
+                 {"regenerative", m.supply.regenerative}};
+  OrderedJson parameters = OrderedJson::object();
+  for (const auto& [number, value] : m.startup_parameters) parameters[std::to_string(number)] = value;
+  j["axis_parameters"] = parameters;
+  return j.dump(2) + "\n";
+}
+
+void write_startup_parameters(const MotorDescription& motor, uint8_t* image, size_t size) {
+  using modules::tmcm1636::Tmcm1636;
+  if (size < Tmcm1636::kNvmLayout.total_size) return;
+  for (const auto& [number, value] : motor.startup_parameters) {
+    if (!check_startup_parameter(number, value).empty()) continue;
+    tmcl::put_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, number), value);
+  }
+}
+
+bool image_configures_motor(const uint8_t* image, size_t size) {
+  using modules::tmcm1636::Tmcm1636;
+  if (size < Tmcm1636::kNvmLayout.total_size) return false;
+  return tmcl::get_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, 14)) != 0;
+}
+
+}  // namespace motwin::sim

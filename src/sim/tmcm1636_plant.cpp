@@ -1,0 +1,328 @@
+#include "sim/tmcm1636_plant.h"
+
+#include <cmath>
+
+#include "core/modules/tmcm1636/tmcm1636_hardware.h"
+
+namespace motwin::sim {
+namespace {
+
+namespace hw = modules::tmcm1636;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kSqrt3 = 1.7320508075688772;
+constexpr double kInverseSqrt3 = 0.57735026918962576;
+constexpr double kOneThird = 1.0 / 3.0;
+// Hall state of sector 0..5 of the hall angle (firmware table core/motion/hall_decoder.h).
+constexpr uint8_t kSectorState[6] = {5, 1, 3, 2, 6, 4};
+
+double radians(double degrees) { return degrees * kPi / 180.0; }
+double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
+// Rounds half away from zero, as lround does, without the library call.
+int32_t round_to_int(double v) { return static_cast<int32_t>(v >= 0.0 ? v + 0.5 : v - 0.5); }
+
+}  // namespace
+
+Tmcm1636Plant::Tmcm1636Plant(const MotorDescription& motor, uint64_t noise_seed, const Tmcm1636BoardModel& board,
+                             int sub_steps)
+    : motor_(motor), board_(board), noise_(noise_seed), sub_steps_(sub_steps < 1 ? 1 : sub_steps) {
+  theta_ = radians(motor_.initial_angle_deg);
+  theta_start_ = theta_;
+  source_voltage_ = motor_.supply.voltage_v;
+  bus_voltage_ = source_voltage_;
+  index_turn_ = static_cast<int64_t>(std::floor((theta_ - radians(motor_.abn.index_deg)) / kTwoPi));
+  latched_.bridge_enabled = false;
+  inverse_resistance_ = 1.0 / motor_.resistance_ohm;
+  inverse_inertia_ = 1.0 / total_inertia_kgm2();
+  inverse_capacitance_ = 1.0 / motor_.supply.capacitance_f;
+  source_conductance_ = 1.0 / motor_.supply.source_resistance_ohm;
+  chopper_conductance_ = 1.0 / motor_.supply.brake_resistor_ohm;
+  for (int source = 0; source < 2; ++source) {
+    for (int chopper = 0; chopper < 2; ++chopper) {
+      const double total = source * source_conductance_ + chopper * chopper_conductance_;
+      inverse_conductance_[source * 2 + chopper] = total > 0.0 ? 1.0 / total : 0.0;
+    }
+  }
+  torque_per_iq_ = motor_.torque_constant();
+  counts_per_radian_ = motor_.abn.counts_per_rev / kTwoPi;
+  inverse_lsb_ = 1.0 / board_.adc_lsb_counts;
+  reluctance_torque_ =
+      motor_.kind == MotorKind::kDc ? 0.0 : 1.5 * motor_.pole_pairs * (motor_.inductance_d_h - motor_.inductance_q_h);
+  sync_electrical_angle();
+  update_index_window();
+}
+
+void Tmcm1636Plant::sync_electrical_angle() {
+  const double electrical = motor_.kind == MotorKind::kDc ? 0.0 : motor_.pole_pairs * theta_;
+  sin_e_ = std::sin(electrical);
+  cos_e_ = std::cos(electrical);
+}
+
+void Tmcm1636Plant::update_index_window() {
+  const double index_angle = radians(motor_.abn.index_deg);
+  index_backward_ = index_angle + kTwoPi * static_cast<double>(index_turn_);
+  index_forward_ = index_backward_ + kTwoPi;
+}
+
+double Tmcm1636Plant::position_revolutions() const { return theta_ / kTwoPi; }
+double Tmcm1636Plant::speed_rpm() const { return omega_ * 60.0 / kTwoPi; }
+
+double Tmcm1636Plant::electromagnetic_torque_nm() const { return (torque_per_iq_ + reluctance_torque_ * id_) * iq_; }
+
+int32_t Tmcm1636Plant::abn_count_at(double theta) const {
+  const double counts = (theta - theta_start_) * counts_per_radian_;
+  auto whole = static_cast<int64_t>(std::floor(counts));
+  if (motor_.abn.reversed) whole = -whole;
+  return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(whole)));
+}
+
+double Tmcm1636Plant::abn_count_at_electrical_zero() const {
+  const double counts = (0.0 - theta_start_) * motor_.abn.counts_per_rev / kTwoPi;
+  return motor_.abn.reversed ? -counts : counts;
+}
+
+double Tmcm1636Plant::abn_count_at_index() const {
+  const double counts = (radians(motor_.abn.index_deg) - theta_start_) * motor_.abn.counts_per_rev / kTwoPi;
+  return motor_.abn.reversed ? -counts : counts;
+}
+
+double Tmcm1636Plant::absolute_reading_at_electrical_zero() const {
+  const double turns = radians(motor_.absolute.offset_deg) / kTwoPi;
+  return (turns - std::floor(turns)) * 65536.0;
+}
+
+void Tmcm1636Plant::sense(board::Tmcm1636Feedback& feedback) {
+  double phase_a = 0.0;
+  double phase_b = 0.0;
+  const double electrical = motor_.pole_pairs * theta_;
+  if (motor_.kind == MotorKind::kDc) {
+    phase_a = iq_;
+    phase_b = -iq_;
+  } else {
+    const double alpha = id_ * cos_e_ - iq_ * sin_e_;
+    const double beta = id_ * sin_e_ + iq_ * cos_e_;
+    phase_a = alpha;
+    phase_b = -0.5 * alpha + 0.5 * kSqrt3 * beta;
+  }
+  const auto adc = [&](double amps, double offset) {
+    const double counts = offset + (amps * 1000.0 + noise_.normal() * board_.current_noise_ma) * board_.adc_counts_per_ma;
+    const double lsb = board_.adc_lsb_counts;
+    double quantised = static_cast<double>(round_to_int(counts * inverse_lsb_)) * lsb;
+    if (quantised < 0.0) quantised = 0.0;
+    if (quantised > 65535.0) quantised = 65536.0 - lsb;
+    return static_cast<uint16_t>(quantised);
+  };
+  feedback.adc_phase_a = adc(phase_a, board_.adc_offset_a);
+  feedback.adc_phase_b = adc(phase_b, board_.adc_offset_b);
+  // ADC_VM: 12 bits over 0..66 V (core/modules/tmcm1636/tmcm1636_hardware.h).
+  constexpr double kSupplyCountsPerVolt = hw::kAdc12Max / (hw::kSupplyFullScaleDecivolt * 0.1);
+  const int32_t supply = round_to_int(bus_voltage_ * kSupplyCountsPerVolt);
+  feedback.adc_supply = static_cast<uint16_t>(supply > hw::kAdc12Max ? hw::kAdc12Max : supply);
+  // The temperature moves in seconds: its ADC reading is refreshed every millisecond.
+  if (ticks_ % 20 == 0) feedback.adc_temperature = hw::temperature_adc_from_celsius(driver_celsius());
+
+  if (!motor_.hall.present || hall_fault_) {
+    feedback.hall = 0;
+  } else {
+    const double hall_angle = (motor_.hall.reversed ? -1.0 : 1.0) * (electrical - radians(motor_.hall.offset_deg));
+    const double turns = hall_angle * (1.0 / kTwoPi);
+    int sector = static_cast<int>((turns - std::floor(turns)) * 6.0);
+    if (sector > 5) sector = 5;
+    uint8_t state = kSectorState[sector];
+    if (motor_.hall.inverted) state = static_cast<uint8_t>(~state & 7);
+    feedback.hall = state;
+  }
+
+  if (motor_.abn.present) {
+    if (!encoder_fault_) frozen_abn_count_ = abn_count_at(theta_);
+    feedback.abn_count = frozen_abn_count_;
+    feedback.abn_index_events = index_events_;
+    feedback.abn_index_count = index_count_;
+  }
+
+  if (motor_.absolute.present) {
+    const double turns =
+        ((motor_.absolute.reversed ? -theta_ : theta_) + radians(motor_.absolute.offset_deg)) / kTwoPi;
+    const double fraction = turns - std::floor(turns);
+    const int bits = motor_.absolute.bits;
+    auto reading = static_cast<uint32_t>(fraction * static_cast<double>(1u << bits));
+    if (reading >= (1u << bits)) reading = (1u << bits) - 1;
+    feedback.absolute_angle = static_cast<uint16_t>(reading << (16 - bits));
+    feedback.absolute_valid = true;
+  } else {
+    feedback.absolute_valid = false;
+  }
+}
+
+void Tmcm1636Plant::advance(const board::Tmcm1636Drive& drive, double dt_s) {
+  const double h = dt_s / sub_steps_;
+  if (h != step_h_) {
+    step_h_ = h;
+    decay_d_ = std::exp(-motor_.resistance_ohm * h / motor_.inductance_d_h);
+    decay_q_ = std::exp(-motor_.resistance_ohm * h / motor_.inductance_q_h);
+    for (int source = 0; source < 2; ++source) {
+      for (int chopper = 0; chopper < 2; ++chopper) {
+        const double conductance =
+            source / motor_.supply.source_resistance_ohm + chopper / motor_.supply.brake_resistor_ohm;
+        bus_decay_[source * 2 + chopper] = std::exp(-conductance / motor_.supply.capacitance_f * h);
+      }
+    }
+    thermal_decay_ = std::exp(-dt_s / (board_.thermal_resistance_k_per_w * board_.thermal_capacitance_j_per_k));
+    brake_decay_ = std::exp(-dt_s / motor_.brake.time_constant_s);
+  }
+  const double da = latched_.duty[0];
+  const double db = latched_.duty[1];
+  const double dc = latched_.duty[2];
+  duty_alpha_ = (2.0 * da - db - dc) * kOneThird;
+  duty_beta_ = (db - dc) * kInverseSqrt3;
+  duty_dc_ = da - db;
+  for (int i = 0; i < sub_steps_; ++i) substep(h);
+
+  // Driver losses -> temperature above ambient (first order).
+  double losses = board_.quiescent_power_w;
+  if (latched_.bridge_enabled) {
+    double abs_sum = 0.0;
+    double square_sum = 0.0;
+    if (motor_.kind == MotorKind::kDc) {
+      abs_sum = 2.0 * std::fabs(iq_);
+      square_sum = 2.0 * iq_ * iq_;
+    } else {
+      square_sum = 1.5 * (id_ * id_ + iq_ * iq_);
+      abs_sum = 2.0 * std::sqrt(id_ * id_ + iq_ * iq_);  // about the sum of |phase currents|
+    }
+    losses += square_sum * board_.switch_on_resistance_ohm +
+              board_.switching_energy_per_volt_amp * bus_voltage_ * abs_sum * latched_.pwm_frequency_hz;
+  }
+  const double steady = losses * board_.thermal_resistance_k_per_w;
+  temperature_rise_ = steady + (temperature_rise_ - steady) * thermal_decay_;
+
+  // Holding brake: the coil current follows the connector duty; the brake opens above the
+  // pull-in level and closes again below the drop-out level.
+  if (motor_.brake.present) {
+    const double duty = latched_.brake_duty_percent;
+    brake_coil_ += (duty - brake_coil_) * (1.0 - brake_decay_);
+    if (brake_coil_ >= motor_.brake.pull_in_duty_percent) brake_released_ = true;
+    if (brake_coil_ < motor_.brake.drop_out_duty_percent) brake_released_ = false;
+  }
+
+  latched_ = drive;
+  ++ticks_;
+  // The rotated sin/cos drift by rounding only: an exact one every millisecond is plenty.
+  if (ticks_ % 20 == 0) sync_electrical_angle();
+}
+
+void Tmcm1636Plant::substep(double h) {
+  const double volts = bus_voltage_;
+  const bool on = latched_.bridge_enabled;
+  double bus_current = 0.0;
+  double torque = 0.0;
+  if (motor_.kind == MotorKind::kDc) {
+    const double kt = motor_.torque_constant_nm_per_a;
+    if (on) {
+      const double duty = duty_dc_;
+      bus_current = duty * iq_;
+      iq_ = decay_q_ * iq_ + (1.0 - decay_q_) * (duty * volts - kt * omega_) * inverse_resistance_;
+    } else {
+      iq_ = 0.0;
+    }
+    id_ = 0.0;
+    torque = kt * iq_;
+  } else {
+    const double s = sin_e_;
+    const double c = cos_e_;
+    if (on) {
+      // Star point voltages from the duties (the common mode drops out), and the bus current
+      // sum(duty_k * i_k) written in alpha/beta: 1.5 (duty_alpha i_alpha + duty_beta i_beta).
+      const double v_alpha = duty_alpha_ * volts;
+      const double v_beta = duty_beta_ * volts;
+      const double vd = v_alpha * c + v_beta * s;
+      const double vq = -v_alpha * s + v_beta * c;
+      const double omega_e = motor_.pole_pairs * omega_;
+      const double i_alpha = id_ * c - iq_ * s;
+      const double i_beta = id_ * s + iq_ * c;
+      bus_current = 1.5 * (duty_alpha_ * i_alpha + duty_beta_ * i_beta);
+      const double new_id =
+          decay_d_ * id_ + (1.0 - decay_d_) * (vd + omega_e * motor_.inductance_q_h * iq_) * inverse_resistance_;
+      const double new_iq =
+          decay_q_ * iq_ + (1.0 - decay_q_) *
+                               (vq - omega_e * motor_.inductance_d_h * id_ - omega_e * motor_.flux_linkage_wb) *
+                               inverse_resistance_;
+      id_ = new_id;
+      iq_ = new_iq;
+    } else {
+      // Open bridge: no current path (the freewheeling diodes conduct only when the back-EMF
+      // exceeds the bus, which this model leaves out; docs/tmcm-1636-servo.md).
+      id_ = 0.0;
+      iq_ = 0.0;
+    }
+    torque = electromagnetic_torque_nm();
+  }
+
+  // Mechanics: J dw/dt = T - B w - (Coulomb friction + engaged brake) sign(w) - T_load.
+  const double driving = torque - load_torque_;
+  const double static_friction =
+      brake_released_ || !motor_.brake.present ? motor_.coulomb_friction_nm
+                                               : motor_.coulomb_friction_nm + motor_.brake.holding_torque_nm;
+  const double omega_before = omega_;
+  if (blocked_) {
+    omega_ = 0.0;
+  } else if (omega_ == 0.0) {
+    if (std::fabs(driving) > static_friction) {
+      omega_ = h * (driving - sign(driving) * static_friction) * inverse_inertia_;
+    }
+  } else {
+    const double net = driving - motor_.viscous_friction_nm_s * omega_ - sign(omega_) * static_friction;
+    const double next = omega_ + h * net * inverse_inertia_;
+    // Friction stops the rotor; whether it starts again is decided from standstill.
+    omega_ = next * omega_ < 0.0 ? 0.0 : next;
+  }
+  const double step = 0.5 * (omega_before + omega_) * h;
+  theta_ += step;
+  if (motor_.kind != MotorKind::kDc && step != 0.0) {
+    // Rotate (sin, cos) by the electrical step: Taylor terms to the 5th order are exact to
+    // double precision for the steps of one sub-step; larger steps take the library call.
+    const double delta = motor_.pole_pairs * step;
+    if (std::fabs(delta) < 0.1) {
+      const double d2 = delta * delta;
+      const double cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+      const double sd = delta * (1.0 - d2 * ((1.0 / 6.0) - d2 * (1.0 / 120.0)));
+      const double s = sin_e_;
+      const double c = cos_e_;
+      sin_e_ = s * cd + c * sd;
+      cos_e_ = c * cd - s * sd;
+    } else {
+      sync_electrical_angle();
+    }
+  }
+
+  // N pulse: the counter latches its value at the index angle.
+  if (motor_.abn.present && !encoder_fault_ && (theta_ >= index_forward_ || theta_ < index_backward_)) {
+    const double crossing = theta_ >= index_forward_ ? index_forward_ : index_backward_;
+    index_turn_ += theta_ >= index_forward_ ? 1 : -1;
+    index_count_ = abn_count_at(crossing + 1e-12);
+    ++index_events_;
+    update_index_window();
+  }
+
+  // Supply bus: the source feeds through a diode (it cannot absorb regenerated energy unless
+  // regenerative), the inverter draws bus_current, the chopper connects the brake resistor.
+  // The board's own logic and gate drivers draw their quiescent power from the bus as well.
+  if (volts > 5.0) bus_current += board_.quiescent_power_w / volts;
+  const bool source_conducts = motor_.supply.regenerative || volts < source_voltage_;
+  const bool chopper = latched_.brake_chopper_on;
+  const double source_g = source_conducts ? source_conductance_ : 0.0;
+  const double chopper_g = chopper ? chopper_conductance_ : 0.0;
+  const int combination = (source_conducts ? 2 : 0) + (chopper ? 1 : 0);
+  double next_volts = volts - bus_current * inverse_capacitance_ * h;
+  if (combination != 0) {
+    const double settle = (source_g * source_voltage_ - bus_current) * inverse_conductance_[combination];
+    next_volts = settle + (volts - settle) * bus_decay_[combination];
+  }
+  if (next_volts < 0.0) next_volts = 0.0;
+  supply_energy_j_ += source_g * (source_voltage_ - volts) * source_voltage_ * h;
+  chopper_energy_j_ += chopper_g * volts * volts * h;
+  bus_voltage_ = next_volts;
+}
+
+}  // namespace motwin::sim

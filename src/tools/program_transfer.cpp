@@ -1,0 +1,127 @@
+#include "tools/program_transfer.h"
+
+#include <limits>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/tmcl/status.h"
+#include "tools/tmcl_mnemonics.h"
+
+namespace motwin::tools {
+namespace {
+
+namespace cmd = tmcl::command;
+
+std::string status_text(uint8_t status) { return fmt::format("status {} ({})", status, tmcl::status_name(status)); }
+
+// Sends `request`, expects `expected_status`; `what` names the step in errors. A reply with
+// another status is stored in `*unexpected_status` when given.
+Result<TmclReply> exchange(TmclClient& client, const tmcl::Instruction& request, uint8_t expected_status,
+                           uint8_t module_address, const std::string& what, uint8_t* unexpected_status = nullptr) {
+  Result<TmclReply> reply = client.request(request, module_address);
+  if (!reply) return Error{fmt::format("{}: {}", what, reply.error())};
+  if (reply->status != expected_status) {
+    if (unexpected_status != nullptr) *unexpected_status = reply->status;
+    return Error{fmt::format("{}: the module answered {}, expected {}", what, status_text(reply->status),
+                             status_text(expected_status))};
+  }
+  return reply;
+}
+
+// One instruction with the two 134 requests.
+Result<tmcl::Instruction> read_instruction(TmclClient& client, uint32_t address, uint8_t module_address,
+                                           uint8_t* unexpected_status = nullptr) {
+  const uint8_t ok = tmcl::to_byte(tmcl::Status::kOk);
+  const auto value_field = static_cast<int32_t>(address);
+  Result<TmclReply> opcode_and_value =
+      exchange(client, {cmd::kReadProgramMemory, 0, 0, value_field}, ok, module_address,
+               fmt::format("reading address {} (134 type 0)", address), unexpected_status);
+  if (!opcode_and_value) return Error{opcode_and_value.error()};
+  Result<TmclReply> type_and_motor = exchange(client, {cmd::kReadProgramMemory, 1, 0, value_field}, ok, module_address,
+                                              fmt::format("reading address {} (134 type 1)", address));
+  if (!type_and_motor) return Error{type_and_motor.error()};
+  const auto fields = static_cast<uint32_t>(type_and_motor->value);
+  if (fields > 0xFFFF) {
+    return Error{
+        fmt::format("reading address {} (134 type 1): value 0x{:X} is not (type << 8) | motor", address, fields)};
+  }
+  return tmcl::Instruction{opcode_and_value->command, static_cast<uint8_t>(fields >> 8), static_cast<uint8_t>(fields),
+                           opcode_and_value->value};
+}
+
+Result<std::vector<tmcl::Instruction>> check_range(uint32_t start, uint32_t count) {
+  if (static_cast<uint64_t>(start) + count > static_cast<uint64_t>(std::numeric_limits<int32_t>::max())) {
+    return Error{fmt::format("cannot read {} instructions from address {}: addresses end at {}", count, start,
+                             std::numeric_limits<int32_t>::max())};
+  }
+  return std::vector<tmcl::Instruction>{};
+}
+
+}  // namespace
+
+Result<std::vector<tmcl::Instruction>> read_program(TmclClient& client, uint32_t start, uint32_t count,
+                                                    uint8_t module_address) {
+  Result<std::vector<tmcl::Instruction>> program = check_range(start, count);
+  if (!program) return program;
+  program->reserve(count);
+  for (uint32_t address = start; address - start < count; ++address) {
+    Result<tmcl::Instruction> instruction = read_instruction(client, address, module_address);
+    if (!instruction) return Error{instruction.error()};
+    program->push_back(instruction.value());
+  }
+  return program;
+}
+
+Result<std::vector<tmcl::Instruction>> read_stored_program(TmclClient& client, uint32_t start, uint32_t max_count,
+                                                           uint8_t module_address) {
+  Result<std::vector<tmcl::Instruction>> program = check_range(start, max_count);
+  if (!program) return program;
+  for (uint32_t address = start; address - start < max_count; ++address) {
+    uint8_t status = tmcl::to_byte(tmcl::Status::kOk);
+    Result<tmcl::Instruction> instruction = read_instruction(client, address, module_address, &status);
+    if (!instruction) {
+      if (address > start && status == tmcl::to_byte(tmcl::Status::kInvalidValue)) break;  // past the end
+      return Error{instruction.error()};
+    }
+    if (instruction->command == cmd::kNop) break;
+    program->push_back(instruction.value());
+  }
+  return program;
+}
+
+Result<size_t> download_program(TmclClient& client, std::span<const tmcl::Instruction> instructions, uint32_t start,
+                                uint8_t module_address) {
+  const uint8_t ok = tmcl::to_byte(tmcl::Status::kOk);
+  const uint8_t stored = tmcl::to_byte(tmcl::Status::kStoredInProgram);
+  if (start > static_cast<uint32_t>(std::numeric_limits<int32_t>::max())) {
+    return Error{fmt::format("start address {} is out of range", start)};
+  }
+  Result<TmclReply> entered =
+      exchange(client, {cmd::kEnterDownloadMode, 0, 0, static_cast<int32_t>(start)}, ok, module_address,
+               fmt::format("entering download mode at address {} (132)", start));
+  if (!entered) return Error{entered.error()};
+
+  const auto leave_after_failure = [&](const std::string& failure) -> Result<size_t> {
+    Result<TmclReply> left = client.request({cmd::kExitDownloadMode, 0, 0, 0}, module_address);
+    const bool left_ok = left && left->status == ok;
+    return Error{fmt::format("{}; {}", failure,
+                             left_ok ? "download mode left (133): program memory may hold part of the new program"
+                                     : "the module may still be in download mode (133 failed)")};
+  };
+
+  for (size_t i = 0; i < instructions.size(); ++i) {
+    Result<TmclReply> reply =
+        exchange(client, instructions[i], stored, module_address,
+                 fmt::format("instruction {} at address {} ({})", i, start + i, format_instruction(instructions[i])));
+    if (!reply) return leave_after_failure(reply.error());
+  }
+  Result<TmclReply> nop = exchange(client, {cmd::kNop, 0, 0, 0}, stored, module_address, "trailing NOP (command 0)");
+  if (!nop) return leave_after_failure(nop.error());
+  Result<TmclReply> left =
+      exchange(client, {cmd::kExitDownloadMode, 0, 0, 0}, ok, module_address, "leaving download mode (133)");
+  if (!left) return Error{left.error()};
+  return instructions.size();
+}
+
+}  // namespace motwin::tools

@@ -1,0 +1,266 @@
+#!/usr/bin/python3
+"""CANopen (CiA-301) interoperability of the TMCM-3216 over the socketcand server, with Debian's
+python3-can as the master's CAN interface and raw frames on the wire:
+
+boot-up after NMT resets; SDO reads of 1000, 1018 and 1008 (segmented); SDO write and read-back
+of 1017 and heartbeats at that period (simulated-time stamps); abort codes for absent objects,
+sub-indices, read-only objects and wrong sizes; NMT start/stop/pre-operational with SDO refused
+while stopped; store/restore (1010/1011) across a restart of the server; two clients see each
+other's frames but not their own; garbage and malformed socketcand elements are tolerated.
+"""
+
+import os
+import sys
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from canopen_harness import (  # noqa: E402
+    LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
+    STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, TestFailure, check, check_equal,
+)
+from motwin_harness import TempDir, run_tests  # noqa: E402
+
+NODE = 5
+
+
+def serve(tmp, **kwargs):
+    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=kwargs.pop("node_id", NODE), **kwargs)
+
+
+def test_bootup_after_nmt_reset(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        bus.nmt(NMT_RESET_NODE, NODE)
+        msg = bus.wait_state(NODE, STATE_BOOTUP)
+        check_equal(bytes(msg.data), b"\x00", "boot-up data")
+        bus.nmt(NMT_RESET_COMM, 0)  # broadcast
+        bus.wait_state(NODE, STATE_BOOTUP)
+        bus.nmt(NMT_RESET_NODE, NODE + 1)  # another node: nothing
+        frames = bus.collect(0.3, lambda m: m.arbitration_id == 0x700 + NODE)
+        check_equal(frames, [], "frames after a reset for another node")
+        server.stop()
+
+
+def test_sdo_reads_of_identity_objects(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 device type")
+        check_equal(bus.upload_u(NODE, 0x1018, 0), 4, "1018 sub 0")
+        check_equal(bus.upload_u(NODE, 0x1018, 1), 0x286, "1018 vendor ID")
+        check_equal(bus.upload_u(NODE, 0x1018, 2), 3216, "1018 product code")
+        check_equal(bus.upload_u(NODE, 0x1018, 3), 0x00010004, "1018 revision")
+        check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "1008 device name (segmented)")
+        check_equal(bus.upload(NODE, 0x100A, 0), b"1.04", "100A software version")
+        check_equal(bus.upload_u(NODE, 0x1014, 0), 0x80 + NODE, "1014 EMCY COB-ID")
+        check_equal(bus.upload_u(NODE, 0x1800, 1), 0x180 + NODE, "1800 sub 1 TPDO 1 COB-ID")
+        check_equal(bus.upload_u(NODE, 0x2708, 0), NODE, "2708 active node ID")
+        server.stop()
+
+
+def test_heartbeat_at_the_1017_period(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        bus.download(NODE, 0x1017, 0, 100, 2)
+        check_equal(bus.upload_u(NODE, 0x1017, 0), 100, "1017 read back")
+        beats = bus.collect(1.2, lambda m: m.arbitration_id == 0x700 + NODE)
+        check(10 <= len(beats) <= 14, f"{len(beats)} heartbeats in 1.2 s at 100 ms")
+        for msg in beats:
+            check_equal(bytes(msg.data), bytes([STATE_PREOP]), "heartbeat state")
+        # Stamped with simulated time: exactly one period apart (1 ms tick resolution).
+        gaps = [round((b.timestamp - a.timestamp) * 1000) for a, b in zip(beats, beats[1:])]
+        check(all(gap == 100 for gap in gaps), f"heartbeat gaps in ms of sim time: {gaps}")
+        bus.download(NODE, 0x1017, 0, 0, 2)
+        bus.drain(0.05)
+        check_equal(bus.collect(0.4, lambda m: m.arbitration_id == 0x700 + NODE), [], "heartbeats after 1017 = 0")
+        server.stop()
+
+
+def test_abort_codes(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        check_equal(bus.abort_code(bus.upload, NODE, 0x1234, 0), 0x06020000, "absent object")
+        check_equal(bus.abort_code(bus.upload, NODE, 0x6040, 0), 0x06020000, "CiA-402 object (not yet)")
+        check_equal(bus.abort_code(bus.upload, NODE, 0x1018, 9), 0x06090011, "absent sub-index")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1000, 0, 1, 4), 0x06010002, "write to 1000")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1017, 0, 1, 4), 0x06070012, "1017 with 4 bytes")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1017, 0, 1, 1), 0x06070013, "1017 with 1 byte")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1029, 1, 7, 1), 0x06090031, "1029 sub 1 too high")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1010, 1, 0x12345678, 4), 0x08000020, "bad signature")
+        # Block upload request: aborted with 05040001 (no block transfer yet).
+        bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 0x7F, 0, 0, 0])
+        msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block upload answer")
+        check_equal(bytes(msg.data), bytes([0x80, 0x08, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05]), "block upload abort")
+        # Still serving.
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 after the aborts")
+        server.stop()
+
+
+def test_nmt_start_stop_preop(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        bus.download(NODE, 0x1017, 0, 50, 2)
+        bus.wait_state(NODE, STATE_PREOP)
+        bus.nmt(NMT_START, NODE)
+        bus.wait_state(NODE, STATE_OPERATIONAL, timeout=0.5)
+        bus.nmt(NMT_STOP, 0)
+        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)
+        bus.send(0x600 + NODE, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
+        answers = bus.collect(0.3, lambda m: m.arbitration_id == 0x580 + NODE)
+        check_equal(answers, [], "SDO answers while stopped")
+        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)  # the heartbeat goes on
+        bus.nmt(NMT_PREOP, NODE)
+        bus.wait_state(NODE, STATE_PREOP, timeout=0.5)
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "SDO in pre-operational again")
+        server.stop()
+
+
+def test_store_and_restore_across_restart(motwin):
+    with TempDir() as tmp:
+        with serve(tmp) as server, server.bus() as bus:
+            bus.download(NODE, 0x1017, 0, 250, 2)
+            bus.download(NODE, 0x1029, 1, 2, 1)
+            bus.download(NODE, 0x1010, 1, SAVE, 4)
+            bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
+            server.stop()
+        with serve(tmp) as server, server.bus() as bus:
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
+            check_equal(bus.upload_u(NODE, 0x1029, 1), 2, "1029 sub 1 after restart")
+            check_equal(bus.upload_u(NODE, 0x1015, 0), 0, "unsaved 1015 after restart")
+            bus.download(NODE, 0x1011, 1, LOAD, 4)
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "restored defaults wait for a reset")
+            bus.nmt(NMT_RESET_NODE, NODE)
+            bus.wait_state(NODE, STATE_BOOTUP)
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 0, "1017 after restore and reset")
+            server.stop()
+
+
+def test_node_id_through_2705_and_2706(motwin):
+    with TempDir() as tmp:
+        with serve(tmp, node_id=None) as server, server.bus() as bus:
+            check_equal(bus.upload_u(1, 0x2708, 0), 1, "default node ID")
+            bus.download(1, 0x2705, 0, 33, 1)
+            bus.download(1, 0x2706, 1, SAVE, 4)
+            bus.nmt(NMT_RESET_COMM, 1)
+            bus.wait_state(33, STATE_BOOTUP)
+            check_equal(bus.upload_u(33, 0x1014, 0), 0x80 + 33, "EMCY COB-ID follows the node ID")
+            server.stop()
+        with serve(tmp, node_id=None) as server, server.bus() as bus:
+            check_equal(bus.upload_u(33, 0x2708, 0), 33, "stored node ID after restart")
+            server.stop()
+
+
+def test_clients_see_each_other_but_not_themselves(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as a, server.bus() as b:
+        a.drain(0.1)
+        b.drain(0.1)
+        a.send(0x123, [1, 2, 3])
+        msg = b.receive(lambda m: m.arbitration_id == 0x123, 1.0, "A's frame at B")
+        check_equal(bytes(msg.data), b"\x01\x02\x03", "data")
+        b.send(0x80, [])  # an empty frame (python-can sends "< send 80 0  >")
+        msg = a.receive(lambda m: m.arbitration_id == 0x80, 1.0, "B's empty frame at A")
+        check_equal(len(msg.data), 0, "empty frame length")
+        check_equal(a.collect(0.3, lambda m: m.arbitration_id == 0x123), [], "A's own frame echoed to A")
+        # Both see the node's answer to A's request.
+        a.send(0x600 + NODE, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
+        b.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "SDO answer seen by B")
+        server.stop()
+
+
+def test_garbage_and_malformed_elements_are_tolerated(motwin):
+    with TempDir() as tmp, serve(tmp) as server:
+        raw = RawSocketcand(server.can_port)
+        try:
+            check_equal(raw.read_element(), "< hi >", "greeting")
+            raw.send("junk < open can0 >")
+            check_equal(raw.read_element(), "< ok >", "open")
+            raw.send("< rawmode >")
+            check_equal(raw.read_element(), "< ok >", "rawmode")
+            raw.send("xx<<< send 601 8 40 >")  # a broken element, then a short send
+            check(raw.read_element().startswith("< error"), "error for a bad send")
+            raw.send("< send 605 2 40 >")  # length does not match
+            check(raw.read_element().startswith("< error"), "error for a length mismatch")
+            raw.send("< bogus command >")
+            check(raw.read_element().startswith("< error"), "error for an unknown command")
+            raw.send("<" + "x" * 1000 + ">")  # overlong: dropped silently
+            raw.send("< echo >")
+            check_equal(raw.read_element(), "< echo >", "echo")
+            raw.send("< send 605 8 40 0 10 0 0 0 0 0 >")
+            while True:
+                element = raw.read_element()
+                if element.startswith("< frame 585 "):
+                    break
+            parts = element.split()
+            check_equal(parts[4], "430010009201FCFF", "SDO answer data")
+            check(parts[3].count(".") == 1 and len(parts[3].split(".")[1]) == 6, f"timestamp {parts[3]}")
+        finally:
+            raw.close()
+        with server.bus() as bus:
+            check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "server still serves")
+        server.stop()
+
+
+def test_client_disconnect_mid_transfer(motwin):
+    with TempDir() as tmp, serve(tmp) as server:
+        with server.bus() as bus:
+            bus.send(0x600 + NODE, [0x40, 0x08, 0x10, 0, 0, 0, 0, 0])  # segmented upload started
+            bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "initiate response")
+        with server.bus() as bus:
+            # The old transfer times out (05040000 after 1 s) or is replaced by this one.
+            check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "a new transfer")
+        check(server.alive(), "server alive")
+        server.stop()
+
+
+def test_serve_argument_errors(motwin):
+    cases = [
+        (["--can", "slcan:/tmp/x"], "--can: expected socketcand"),
+        (["--can", "socketcand:127.0.0.1:0", "--tmcl-tcp", "127.0.0.1:0"], "has no TMCL interface"),
+        (["--can", "socketcand:127.0.0.1:0", "--node-id", "128"], "--node-id"),
+    ]
+    with TempDir() as tmp:
+        for extra, expected in cases:
+            server = CanServer(MOTWIN, "none")
+            server.args = [MOTWIN, "serve", "--module", "tmcm-3216", "--state-dir", "none"] + extra
+            try:
+                check_equal(server.start_expect_failure(), 2, f"exit status for {extra}")
+                lines = server.stderr_lines()
+                check(len(lines) == 1 and lines[0].startswith("motwin: error: ") and expected in lines[0],
+                      f"stderr for {extra}: {lines!r}")
+            finally:
+                server.cleanup()
+        # A TMCL module has no CAN interface yet.
+        server = CanServer(MOTWIN, "none")
+        server.args = [MOTWIN, "serve", "--module", "tmcm-1636", "--state-dir", "none",
+                       "--can", "socketcand:127.0.0.1:0"]
+        try:
+            check_equal(server.start_expect_failure(), 2, "exit status for tmcm-1636 --can")
+            check("has no CAN interface" in server.stderr_text(), f"stderr: {server.stderr_text()!r}")
+        finally:
+            server.cleanup()
+        del tmp
+
+
+def main():
+    global MOTWIN
+    import motwin_harness
+    args = motwin_harness.parse_arguments()
+    MOTWIN = os.path.abspath(args.motwin)
+    try:
+        import can  # noqa: F401
+    except ImportError:
+        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
+    run_tests([
+        test_bootup_after_nmt_reset,
+        test_sdo_reads_of_identity_objects,
+        test_heartbeat_at_the_1017_period,
+        test_abort_codes,
+        test_nmt_start_stop_preop,
+        test_store_and_restore_across_restart,
+        test_node_id_through_2705_and_2706,
+        test_clients_see_each_other_but_not_themselves,
+        test_garbage_and_malformed_elements_are_tolerated,
+        test_client_disconnect_mid_transfer,
+        test_serve_argument_errors,
+    ])
+
+
+MOTWIN = None
+
+if __name__ == "__main__":
+    main()
