@@ -9,7 +9,7 @@ status=0
 
 # Undefined symbols the core may use: freestanding C library and libm functions (and the
 # sanitizer runtime hooks in the ASan + UBSan build).
-allowed='^(__asan_[a-z0-9_]+|__ubsan_[a-z0-9_]+|__sanitizer_[a-z0-9_]+|memcpy|memmove|memset|memcmp|strlen|sqrt|sqrtf|fabs|llround|lround|round|floor|ceil|sin|cos|sinf|cosf|sincos|sincosf|atan2|atan2f|fmod|exp|log|pow|__stack_chk_fail|_GLOBAL_OFFSET_TABLE_|__dso_handle|__cxa_pure_virtual|__cxa_guard_acquire|__cxa_guard_release|__cxa_guard_abort|__cxa_atexit)$'
+allowed='^(__asan_[a-z0-9_]+|__ubsan_[a-z0-9_]+|__sanitizer_[a-z0-9_]+|memcpy|memmove|memset|memcmp|strlen|sqrt|sqrtf|fabs|llround|lround|round|floor|ceil|sin|cos|sinf|cosf|sincos|sincosf|atan2|atan2f|fmod|exp|log|pow|copysign|copysignf|__stack_chk_fail|_GLOBAL_OFFSET_TABLE_|__dso_handle|__cxa_pure_virtual|__cxa_guard_acquire|__cxa_guard_release|__cxa_guard_abort|__cxa_atexit)$'
 undefined=$(nm --undefined-only --format=just-symbols "$archive" | sort -u)
 bad=$(echo "$undefined" | grep -v -E '^$' | grep -v -E "$allowed" || true)
 # Core objects refer to each other; those are defined somewhere in the archive.

@@ -44,7 +44,8 @@ Words split_words(std::string_view text) {
       if (words.count == kMaxWords) {
         words.too_many = true;
       } else {
-        words.word[words.count++] = text.substr(start, i - start);
+        // Not substr(): it may throw, and the core has no exceptions.
+        words.word[words.count++] = std::string_view(text.data() + start, i - start);
       }
       comma_pending = false;
     }
