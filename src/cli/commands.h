@@ -18,5 +18,7 @@ void add_program_control_commands(CLI::App& app, int& exit_status);
 void add_run_command(CLI::App& app, int& exit_status);
 // CANopen: `motwin eds` (docs/canopen.md)
 void add_eds_command(CLI::App& app, int& exit_status);
+// `motwin sdo read|write`, `motwin nmt`
+void add_canopen_commands(CLI::App& app, int& exit_status);
 
 }  // namespace motwin::cli

@@ -26,6 +26,7 @@
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
 #include "host/can_bus.h"
+#include "host/can_capture.h"
 #include "host/can_endpoint.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
@@ -51,6 +52,7 @@ struct ServeArguments {
   std::string pty_link;
   std::vector<std::string> can_endpoints;
   int node_id = 0;
+  std::string can_capture;
   std::string state_dir;
   std::string speed = "realtime";
   std::vector<std::string> assignments;
@@ -200,6 +202,21 @@ int run_serve(const ServeArguments& arguments) {
     }
   } bus_membership{can_specs.empty() ? nullptr : module.can_node()};
   if (bus_membership.node != nullptr) bus_membership.node->connect(can_bus);
+  std::unique_ptr<host::CanCapture> can_capture;
+  struct CaptureMembership {
+    host::CanBus& bus;
+    host::CanBus::EndpointId id = 0;
+    ~CaptureMembership() {
+      if (id != 0) bus.detach(id);
+    }
+  } capture_membership{can_bus};
+  if (!arguments.can_capture.empty()) {
+    if (can_specs.empty()) throw ServeError{"--can-capture needs a CAN bus (--can)"};
+    host::CanCapture::OpenResult opened = host::CanCapture::open(arguments.can_capture);
+    if (!opened.capture) throw ServeError{"--can-capture: " + opened.error};
+    can_capture = std::move(opened.capture);
+    capture_membership.id = can_bus.attach(*can_capture);
+  }
   std::vector<std::unique_ptr<host::SocketcandServer>> can_servers;
   std::vector<std::unique_ptr<host::SlcanTcpServer>> slcan_servers;
   std::vector<std::string> can_endpoint_lines;
@@ -284,6 +301,10 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--can-capture", arguments->can_capture,
+                    "Write every frame of the CAN bus to FILE (simulated time): pcap with link type 227 when FILE "
+                    "ends in .pcap (Wireshark, tshark), otherwise a candump -L log")
+      ->type_name("FILE");
   serve->add_option("--node-id", arguments->node_id,
                     "CANopen node ID as the module's address switches would set it (1..127); without it the "
                     "stored node ID (object 2705, default 1) applies")

@@ -165,7 +165,7 @@ void Tmcm1636Plant::advance(const board::Tmcm1636Drive& drive, double dt_s) {
       for (int chopper = 0; chopper < 2; ++chopper) {
         const double conductance =
             source / motor_.supply.source_resistance_ohm + chopper / motor_.supply.brake_resistor_ohm;
-        bus_decay_[source * 2 + chopper] = std::exp(-conductance / motor_.supply.capacitance_f * h);
+        bus_decay_[source * 2 + chopper] = std::exp(-conductance / motor_.supply.capacitance_f * dt_s);
       }
     }
     thermal_decay_ = std::exp(-dt_s / (board_.thermal_resistance_k_per_w * board_.thermal_capacitance_j_per_k));
@@ -177,7 +177,26 @@ void Tmcm1636Plant::advance(const board::Tmcm1636Drive& drive, double dt_s) {
   duty_alpha_ = (2.0 * da - db - dc) * kOneThird;
   duty_beta_ = (db - dc) * kInverseSqrt3;
   duty_dc_ = da - db;
-  for (int i = 0; i < sub_steps_; ++i) substep(h);
+  // Electrical sub-steps with the rotor turning at the tick's initial speed (the mechanics move
+  // far slower than the currents), then the mechanics over the whole tick with the mean torque.
+  const double sin_start = sin_e_;
+  const double cos_start = cos_e_;
+  const double theta_start = theta_;
+  double rotate_cos = 1.0;
+  double rotate_sin = 0.0;
+  if (motor_.kind != MotorKind::kDc) rotation(motor_.pole_pairs * omega_ * h, rotate_cos, rotate_sin);
+  double torque_sum = 0.0;
+  for (int i = 0; i < sub_steps_; ++i) torque_sum += electrical_substep(rotate_cos, rotate_sin);
+  mechanics(dt_s, torque_sum / sub_steps_);
+  if (motor_.kind != MotorKind::kDc) {
+    // The angle the rotor really turned, from the exact start of the tick.
+    double c = 1.0;
+    double sn = 0.0;
+    rotation(motor_.pole_pairs * (theta_ - theta_start), c, sn);
+    sin_e_ = sin_start * c + cos_start * sn;
+    cos_e_ = cos_start * c - sin_start * sn;
+  }
+  update_bus(dt_s);
 
   // Driver losses -> temperature above ambient (first order).
   double losses = board_.quiescent_power_w;
@@ -212,54 +231,72 @@ void Tmcm1636Plant::advance(const board::Tmcm1636Drive& drive, double dt_s) {
   if (ticks_ % 20 == 0) sync_electrical_angle();
 }
 
-void Tmcm1636Plant::substep(double h) {
-  const double volts = bus_voltage_;
+
+// cos and sin of a small angle: Taylor terms to the 5th order are exact to double precision
+// below 0.1 rad; larger angles take the library call.
+void Tmcm1636Plant::rotation(double delta, double& c, double& s) {
+  if (std::fabs(delta) < 0.1) {
+    const double d2 = delta * delta;
+    c = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+    s = delta * (1.0 - d2 * ((1.0 / 6.0) - d2 * (1.0 / 120.0)));
+  } else {
+    c = std::cos(delta);
+    s = std::sin(delta);
+  }
+}
+
+// One electrical sub-step: the exact exponential update of the RL circuits with the back-EMF and
+// the cross-coupling held, the electrical angle rotated by (rotate_cos, rotate_sin) after it.
+// Returns the torque at its end and adds the inverter's bus current to the tick's sum.
+double Tmcm1636Plant::electrical_substep(double rotate_cos, double rotate_sin) {
+  const double volts = bus_voltage_;  // held over the tick (update_bus)
   const bool on = latched_.bridge_enabled;
-  double bus_current = 0.0;
-  double torque = 0.0;
   if (motor_.kind == MotorKind::kDc) {
-    const double kt = motor_.torque_constant_nm_per_a;
     if (on) {
-      const double duty = duty_dc_;
-      bus_current = duty * iq_;
-      iq_ = decay_q_ * iq_ + (1.0 - decay_q_) * (duty * volts - kt * omega_) * inverse_resistance_;
+      bus_current_sum_ += duty_dc_ * iq_;
+      iq_ = decay_q_ * iq_ + (1.0 - decay_q_) * (duty_dc_ * volts - motor_.torque_constant_nm_per_a * omega_) *
+                                 inverse_resistance_;
     } else {
       iq_ = 0.0;
     }
     id_ = 0.0;
-    torque = kt * iq_;
-  } else {
-    const double s = sin_e_;
-    const double c = cos_e_;
-    if (on) {
-      // Star point voltages from the duties (the common mode drops out), and the bus current
-      // sum(duty_k * i_k) written in alpha/beta: 1.5 (duty_alpha i_alpha + duty_beta i_beta).
-      const double v_alpha = duty_alpha_ * volts;
-      const double v_beta = duty_beta_ * volts;
-      const double vd = v_alpha * c + v_beta * s;
-      const double vq = -v_alpha * s + v_beta * c;
-      const double omega_e = motor_.pole_pairs * omega_;
-      const double i_alpha = id_ * c - iq_ * s;
-      const double i_beta = id_ * s + iq_ * c;
-      bus_current = 1.5 * (duty_alpha_ * i_alpha + duty_beta_ * i_beta);
-      const double new_id =
-          decay_d_ * id_ + (1.0 - decay_d_) * (vd + omega_e * motor_.inductance_q_h * iq_) * inverse_resistance_;
-      const double new_iq =
-          decay_q_ * iq_ + (1.0 - decay_q_) *
-                               (vq - omega_e * motor_.inductance_d_h * id_ - omega_e * motor_.flux_linkage_wb) *
-                               inverse_resistance_;
-      id_ = new_id;
-      iq_ = new_iq;
-    } else {
-      // Open bridge: no current path (the freewheeling diodes conduct only when the back-EMF
-      // exceeds the bus, which this model leaves out; docs/tmcm-1636-servo.md).
-      id_ = 0.0;
-      iq_ = 0.0;
-    }
-    torque = electromagnetic_torque_nm();
+    return motor_.torque_constant_nm_per_a * iq_;
   }
+  const double s = sin_e_;
+  const double c = cos_e_;
+  if (on) {
+    // Star point voltages from the duties (the common mode drops out), and the bus current
+    // sum(duty_k * i_k) written in alpha/beta: 1.5 (duty_alpha i_alpha + duty_beta i_beta).
+    const double v_alpha = duty_alpha_ * volts;
+    const double v_beta = duty_beta_ * volts;
+    const double vd = v_alpha * c + v_beta * s;
+    const double vq = -v_alpha * s + v_beta * c;
+    const double omega_e = motor_.pole_pairs * omega_;
+    const double i_alpha = id_ * c - iq_ * s;
+    const double i_beta = id_ * s + iq_ * c;
+    bus_current_sum_ += 1.5 * (duty_alpha_ * i_alpha + duty_beta_ * i_beta);
+    const double new_id =
+        decay_d_ * id_ + (1.0 - decay_d_) * (vd + omega_e * motor_.inductance_q_h * iq_) * inverse_resistance_;
+    const double new_iq =
+        decay_q_ * iq_ + (1.0 - decay_q_) *
+                             (vq - omega_e * motor_.inductance_d_h * id_ - omega_e * motor_.flux_linkage_wb) *
+                             inverse_resistance_;
+    id_ = new_id;
+    iq_ = new_iq;
+  } else {
+    // Open bridge: no current path (the freewheeling diodes conduct only when the back-EMF
+    // exceeds the bus, which this model leaves out; docs/tmcm-1636-servo.md).
+    id_ = 0.0;
+    iq_ = 0.0;
+  }
+  sin_e_ = s * rotate_cos + c * rotate_sin;
+  cos_e_ = c * rotate_cos - s * rotate_sin;
+  return electromagnetic_torque_nm();
+}
 
-  // Mechanics: J dw/dt = T - B w - (Coulomb friction + engaged brake) sign(w) - T_load.
+// Mechanics over one tick: J dw/dt = T - B w - (Coulomb friction + engaged brake) sign(w) - T_load,
+// with the tick's mean electromagnetic torque.
+void Tmcm1636Plant::mechanics(double dt_s, double torque) {
   const double driving = torque - load_torque_;
   const double static_friction =
       brake_released_ || !motor_.brake.present ? motor_.coulomb_friction_nm
@@ -269,32 +306,15 @@ void Tmcm1636Plant::substep(double h) {
     omega_ = 0.0;
   } else if (omega_ == 0.0) {
     if (std::fabs(driving) > static_friction) {
-      omega_ = h * (driving - sign(driving) * static_friction) * inverse_inertia_;
+      omega_ = dt_s * (driving - sign(driving) * static_friction) * inverse_inertia_;
     }
   } else {
     const double net = driving - motor_.viscous_friction_nm_s * omega_ - sign(omega_) * static_friction;
-    const double next = omega_ + h * net * inverse_inertia_;
+    const double next = omega_ + dt_s * net * inverse_inertia_;
     // Friction stops the rotor; whether it starts again is decided from standstill.
     omega_ = next * omega_ < 0.0 ? 0.0 : next;
   }
-  const double step = 0.5 * (omega_before + omega_) * h;
-  theta_ += step;
-  if (motor_.kind != MotorKind::kDc && step != 0.0) {
-    // Rotate (sin, cos) by the electrical step: Taylor terms to the 5th order are exact to
-    // double precision for the steps of one sub-step; larger steps take the library call.
-    const double delta = motor_.pole_pairs * step;
-    if (std::fabs(delta) < 0.1) {
-      const double d2 = delta * delta;
-      const double cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
-      const double sd = delta * (1.0 - d2 * ((1.0 / 6.0) - d2 * (1.0 / 120.0)));
-      const double s = sin_e_;
-      const double c = cos_e_;
-      sin_e_ = s * cd + c * sd;
-      cos_e_ = c * cd - s * sd;
-    } else {
-      sync_electrical_angle();
-    }
-  }
+  theta_ += 0.5 * (omega_before + omega_) * dt_s;
 
   // N pulse: the counter latches its value at the index angle.
   if (motor_.abn.present && !encoder_fault_ && (theta_ >= index_forward_ || theta_ < index_backward_)) {
@@ -304,24 +324,31 @@ void Tmcm1636Plant::substep(double h) {
     ++index_events_;
     update_index_window();
   }
+}
 
-  // Supply bus: the source feeds through a diode (it cannot absorb regenerated energy unless
-  // regenerative), the inverter draws bus_current, the chopper connects the brake resistor.
-  // The board's own logic and gate drivers draw their quiescent power from the bus as well.
+// The supply bus over one tick (its R C of tens of microseconds is solved exactly for the tick's
+// mean inverter current): the source feeds through a diode (it cannot absorb regenerated energy
+// unless regenerative), the inverter draws the mean of sum(duty_k i_k), the board its quiescent
+// power, the chopper connects the brake resistor.
+void Tmcm1636Plant::update_bus(double dt_s) {
+  const double volts = bus_voltage_;
+  double bus_current = bus_current_sum_ / sub_steps_;
+  bus_current_sum_ = 0.0;
   if (volts > 5.0) bus_current += board_.quiescent_power_w / volts;
   const bool source_conducts = motor_.supply.regenerative || volts < source_voltage_;
   const bool chopper = latched_.brake_chopper_on;
   const double source_g = source_conducts ? source_conductance_ : 0.0;
   const double chopper_g = chopper ? chopper_conductance_ : 0.0;
   const int combination = (source_conducts ? 2 : 0) + (chopper ? 1 : 0);
-  double next_volts = volts - bus_current * inverse_capacitance_ * h;
+  double next_volts = volts - bus_current * inverse_capacitance_ * dt_s;
   if (combination != 0) {
     const double settle = (source_g * source_voltage_ - bus_current) * inverse_conductance_[combination];
     next_volts = settle + (volts - settle) * bus_decay_[combination];
   }
   if (next_volts < 0.0) next_volts = 0.0;
-  supply_energy_j_ += source_g * (source_voltage_ - volts) * source_voltage_ * h;
-  chopper_energy_j_ += chopper_g * volts * volts * h;
+  const double mean_volts = 0.5 * (volts + next_volts);
+  supply_energy_j_ += source_g * (source_voltage_ - mean_volts) * source_voltage_ * dt_s;
+  chopper_energy_j_ += chopper_g * mean_volts * mean_volts * dt_s;
   bus_voltage_ = next_volts;
 }
 

@@ -4,8 +4,10 @@
 // capacitance, brake-chopper resistor), current sensing through the ADC with seeded noise, hall
 // sensors, an ABN encoder with index, an absolute encoder and the driver's thermal model.
 //
-// Integrated in double precision with kSubSteps sub-steps per control tick; the RL circuits use
-// the exact exponential update (stable at any step). The PWM computed in a tick is applied from
+// Integrated in double precision: the currents in 3 sub-steps per control tick
+// (kDefaultSubSteps) by the exact exponential update of the RL circuits (stable at any step), with
+// the rotor turning at the tick's initial speed; the mechanics and the supply bus (whose time
+// constants are far longer than a sub-step, or solved exactly) once per tick. The PWM computed in a tick is applied from
 // the next tick on (one-tick delay). Equations and defaults: docs/tmcm-1636-servo.md.
 #pragma once
 
@@ -110,7 +112,10 @@ class Tmcm1636Plant {
   double absolute_reading_at_electrical_zero() const;
 
  private:
-  void substep(double h);
+  static void rotation(double delta, double& c, double& s);
+  double electrical_substep(double rotate_cos, double rotate_sin);
+  void mechanics(double dt_s, double torque);
+  void update_bus(double dt_s);
   int32_t abn_count_at(double theta) const;
   void sync_electrical_angle();
   void update_index_window();
@@ -150,7 +155,8 @@ class Tmcm1636Plant {
   double step_h_ = 0.0;
   double decay_d_ = 0.0;
   double decay_q_ = 0.0;
-  double bus_decay_[4] = {};  // [source conducting][chopper on]
+  double bus_decay_[4] = {};  // per tick, [source conducting][chopper on]
+  double bus_current_sum_ = 0.0;
   // The latched duties as the stationary voltage vector per volt of bus (alpha, beta), and the
   // DC motor's U-V duty difference: set once per tick.
   double duty_alpha_ = 0.0;

@@ -207,6 +207,67 @@ def test_client_disconnect_mid_transfer(motwin):
         server.stop()
 
 
+def test_heartbeat_consumer_emcy(motwin):
+    """The master (node 0x10 here) sends heartbeats, then stops: EMCY 8130 with 1001 bit 4 (and
+    bit 0), 1029 sub 1 = 0 stops the operational node; the next heartbeat gives EMCY 0000."""
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        bus.download(NODE, 0x1016, 1, (0x10 << 16) | 200, 4)  # producer 0x10, 200 ms
+        bus.download(NODE, 0x1017, 0, 50, 2)
+        bus.nmt(NMT_START, NODE)
+        bus.wait_state(NODE, STATE_OPERATIONAL, timeout=0.5)
+        for _ in range(3):
+            bus.send(0x710, [0x05])
+            bus.drain(0.05)
+        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 1.0, "EMCY after the heartbeats stop")
+        check_equal(bytes(emcy.data), bytes([0x30, 0x81, 0x11, 0x00, 0xFF, 0x00, 0x00, 0x00]), "EMCY 8130")
+        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)
+        bus.send(0x710, [0x05])  # back: EMCY 0000 waits while stopped (no EMCY in stopped)...
+        check_equal(bus.collect(0.2, lambda m: m.arbitration_id == 0x80 + NODE), [], "EMCY while stopped")
+        bus.nmt(NMT_PREOP, NODE)  # ...and goes out in pre-operational
+        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 1.0, "EMCY 0000 in pre-operational")
+        check_equal(bytes(emcy.data), bytes([0, 0, 0, 0, 0xFF, 0, 0, 0]), "EMCY 0000")
+        check_equal(bus.upload_u(NODE, 0x1001, 0), 0x00, "1001 after the heartbeat came back")
+        server.stop()
+
+
+def test_bus_capture_pcap_and_candump(motwin):
+    """--can-capture: pcap (link type 227, IDs big-endian) or candump -L log, simulated time."""
+    import struct as st
+    with TempDir() as tmp:
+        for name in ("bus.pcap", "bus.log"):
+            path = os.path.join(tmp, name)
+            with serve(tmp, extra_args=("--can-capture", path)) as server, server.bus() as bus:
+                bus.nmt(NMT_RESET_NODE, NODE)
+                bus.wait_state(NODE, STATE_BOOTUP)
+                check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000")
+                server.stop()
+            data = open(path, "rb").read()
+            if name.endswith(".pcap"):
+                magic, major, minor, _, _, snaplen, linktype = st.unpack_from("<IHHiIII", data, 0)
+                check_equal((magic, major, minor, linktype), (0xA1B2C3D4, 2, 4, 227), "pcap header")
+                frames = []
+                offset = 24
+                while offset < len(data):
+                    sec, usec, incl, orig = st.unpack_from("<IIII", data, offset)
+                    can_id, dlc = st.unpack_from(">IB", data, offset + 16)
+                    frames.append((can_id, bytes(data[offset + 24:offset + 24 + dlc]), sec + usec / 1e6))
+                    check_equal((incl, orig), (16, 16), "record length")
+                    offset += 16 + incl
+                check_equal(frames[0][:2], (0x000, bytes([NMT_RESET_NODE, NODE])), "first frame: the NMT reset")
+                check_equal(frames[1][:2], (0x700 + NODE, b"\x00"), "boot-up")
+                check_equal(frames[2][:2], (0x600 + NODE, bytes([0x40, 0, 0x10, 0, 0, 0, 0, 0])), "SDO request")
+                check_equal(frames[3][:2], (0x580 + NODE, bytes([0x43, 0, 0x10, 0, 0x92, 1, 0xFC, 0xFF])),
+                            "SDO response")
+                check(frames[0][2] <= frames[3][2], "timestamps in order")
+            else:
+                lines = data.decode("ascii").splitlines()
+                check(len(lines) >= 4, f"candump lines {lines!r}")
+                check(lines[0].endswith(f" can0 000#81{NODE:02X}"), f"line 1 {lines[0]!r}")
+                check(lines[1].endswith(f" can0 7{NODE:02X}#00"), f"line 2 {lines[1]!r}")
+                check(lines[3].endswith(f" can0 58{NODE:X}#430010009201FCFF"), f"line 4 {lines[3]!r}")
+                check(lines[0].startswith("(") and ") can0 " in lines[0], "candump -L form")
+
+
 def test_serve_argument_errors(motwin):
     cases = [
         (["--can", "slcan:/tmp/x"], "--can: expected socketcand"),
@@ -256,6 +317,8 @@ def main():
         test_clients_see_each_other_but_not_themselves,
         test_garbage_and_malformed_elements_are_tolerated,
         test_client_disconnect_mid_transfer,
+        test_heartbeat_consumer_emcy,
+        test_bus_capture_pcap_and_candump,
         test_serve_argument_errors,
     ])
 

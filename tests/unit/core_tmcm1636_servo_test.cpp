@@ -399,6 +399,24 @@ TEST(Tmcm1636Servo, undervoltage_switches_the_bridge_off) {
   EXPECT_NEAR(rig.speed_rpm(), 1000.0, 15.0) << "back on";
 }
 
+TEST(Tmcm1636Servo, overtemperature_switches_the_bridge_off_until_the_driver_cools) {
+  Tmcm1636ServoRig rig(default_motor());
+  rig.sap(30, 500);
+  rig.run_ms(10);
+  rig.set("TEMP", 105.0);  // ambient: the driver reads a little more
+  rig.run_ms(5);
+  EXPECT_GE(rig.gap(221), 105) << "AP 221";
+  EXPECT_TRUE(rig.gap(156) & flag::kOvertemperature);
+  EXPECT_EQ(rig.plant().iq_amps(), 0.0);
+  rig.set("TEMP", 95.0);
+  rig.run_ms(5);
+  EXPECT_TRUE(rig.gap(156) & flag::kOvertemperature) << "hysteresis: clears below 90 °C";
+  rig.set("TEMP", 80.0);
+  rig.run_ms(5);
+  EXPECT_FALSE(rig.gap(156) & flag::kOvertemperature);
+  EXPECT_TRUE(rig.gap(156) & flag::kPowerStageOn);
+}
+
 // --- Reference switches, driver enable, brake -------------------------------------------------
 
 TEST(Tmcm1636Servo, reference_switch_stops_the_motor) {

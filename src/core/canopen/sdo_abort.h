@@ -43,4 +43,43 @@ enum class SdoAbort : uint32_t {
 
 constexpr uint32_t code(SdoAbort abort) { return static_cast<uint32_t>(abort); }
 
+// The description of table 366 (empty for a code not in it).
+constexpr const char* describe(uint32_t abort_code) {
+  switch (static_cast<SdoAbort>(abort_code)) {
+    case SdoAbort::kNone: return "no error";
+    case SdoAbort::kToggleBit: return "toggle bit not alternated";
+    case SdoAbort::kTimeout: return "SDO protocol timed out";
+    case SdoAbort::kUnknownCommand: return "client/server command specifier not valid or unknown";
+    case SdoAbort::kInvalidBlockSize: return "invalid block size";
+    case SdoAbort::kInvalidSequence: return "invalid sequence number";
+    case SdoAbort::kCrc: return "CRC error";
+    case SdoAbort::kOutOfMemory: return "out of memory";
+    case SdoAbort::kUnsupportedAccess: return "unsupported access to an object";
+    case SdoAbort::kWriteOnly: return "attempt to read a write only object";
+    case SdoAbort::kReadOnly: return "attempt to write a read only object";
+    case SdoAbort::kNoObject: return "object does not exist in the object dictionary";
+    case SdoAbort::kNotMappable: return "object cannot be mapped to the PDO";
+    case SdoAbort::kMappingTooLong: return "the number and length of the objects to be mapped exceed the PDO length";
+    case SdoAbort::kParameterIncompatible: return "general parameter incompatibility reason";
+    case SdoAbort::kDeviceIncompatible: return "general internal incompatibility in the device";
+    case SdoAbort::kHardware: return "access failed due to a hardware error";
+    case SdoAbort::kTypeMismatch: return "data type does not match, length of service parameter does not match";
+    case SdoAbort::kDataTooLong: return "data type does not match, length of service parameter too high";
+    case SdoAbort::kDataTooShort: return "data type does not match, length of service parameter too low";
+    case SdoAbort::kNoSubIndex: return "sub-index does not exist";
+    case SdoAbort::kInvalidValue: return "invalid value for parameter";
+    case SdoAbort::kValueTooHigh: return "value of parameter too high";
+    case SdoAbort::kValueTooLow: return "value of parameter too low";
+    case SdoAbort::kMaxLessThanMin: return "maximum value is less than minimum value";
+    case SdoAbort::kResourceUnavailable: return "resource not available";
+    case SdoAbort::kGeneral: return "general error";
+    case SdoAbort::kDataTransfer: return "data cannot be transferred or stored to the application";
+    case SdoAbort::kLocalControl: return "data cannot be transferred or stored to the application because of local control";
+    case SdoAbort::kDeviceState: return "data cannot be transferred or stored to the application because of the present device state";
+    case SdoAbort::kNoDictionary: return "object dictionary dynamic generation failed or no object dictionary is present";
+    case SdoAbort::kNoData: return "no data available";
+  }
+  return "";
+}
+
 }  // namespace motwin::canopen

@@ -385,6 +385,8 @@ void Tmcm1636Axis::servo_tick(board::Tmcm1636PowerStage& stage, double dt_s) {
   const bool dc = config.motor_type == 1;
   const int32_t commutation = config.commutation_mode;
   const bool fault = s.undervoltage || s.overvoltage || s.overtemperature;
+  // Only a BLDC motor has a commutation offset to find.
+  if (!bldc) state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kIdle);
   const bool bridge = state.driver_enabled != 0 && (bldc || dc) && commutation != 0 && !fault;
 
   if (!bridge) {

@@ -22,6 +22,7 @@ Tmcm3216::Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, con
       dictionary_(*this, object_table(), kAxisCount),
       nmt_(can),
       sdo_(dictionary_, can),
+      emergency_(can),
       storage_(dictionary_, nvm, storage_scratch_.data(), storage_scratch_.size()) {}
 
 void Tmcm3216::power_up() {
@@ -42,6 +43,8 @@ void Tmcm3216::reset_node() {
 void Tmcm3216::reset_communication() {
   nmt_.initialize();
   sdo_.reset();
+  emergency_.reset();
+  error_register_ = 0;
   // Node ID and bit rate first: the "$NODEID+" defaults of the communication objects use it.
   StorageSelection node;
   node.node_settings = true;
@@ -54,7 +57,7 @@ void Tmcm3216::reset_communication() {
   sdo_.set_node_id(node_id_);
   StorageSelection communication;
   communication.communication = true;
-  storage_.load(communication);  // 1017 reaches nmt_ through its binding
+  storage_.load(communication);  // 1014..1017 reach emergency_, heartbeat_consumer_, nmt_ by their bindings
   // An LSS-unconfigured node (2705 = 255) stays silent until LSS gives it an ID (not yet).
   if (configured()) nmt_.boot();
 }
@@ -77,8 +80,37 @@ void Tmcm3216::process(uint32_t elapsed_us) {
     handle_frame(frame);
   }
   run_nmt(elapsed_us);
+  run_heartbeat_consumer(elapsed_us);
   const NmtState state = nmt_.state();
-  if (state == NmtState::kPreOperational || state == NmtState::kOperational) sdo_.process(elapsed_us);
+  if (state == NmtState::kPreOperational || state == NmtState::kOperational) {
+    sdo_.process(elapsed_us);
+    emergency_.process(elapsed_us);  // EMCY is not sent in stopped (CiA-301 table 86)
+  }
+}
+
+void Tmcm3216::run_heartbeat_consumer(uint32_t elapsed_us) {
+  // Manual table 365: byte 2 of 8130 is 255 (no motor).
+  static constexpr uint8_t kNoMotor[5] = {0, 255, 0, 0, 0};
+  switch (heartbeat_consumer_.process(elapsed_us)) {
+    case canopen::HeartbeatEvent::kNone: return;
+    case canopen::HeartbeatEvent::kTimeout:
+      error_register_ |= canopen::kErrorRegisterCommunication | canopen::kErrorRegisterGeneric;
+      emergency_.report(canopen::kEmcyHeartbeat, error_register_, kNoMotor);
+      // Out before a change to stopped would hold it back (unless an inhibit time is running).
+      if (nmt_.state() != NmtState::kStopped) emergency_.process(0);
+      // 1029 sub 1 (manual 3.1.14, table 39): in operational, 0 "enter stopped state",
+      // 1 "remain in current state", 2 stopped (CiA-301).
+      if (nmt_.state() == NmtState::kOperational && communication_.error_behavior[0] != 1) {
+        nmt_.enter(NmtState::kStopped);
+        sdo_.reset();
+      }
+      return;
+    case canopen::HeartbeatEvent::kRecovered:
+      error_register_ = static_cast<uint8_t>(error_register_ & ~canopen::kErrorRegisterCommunication);
+      if (error_register_ == canopen::kErrorRegisterGeneric) error_register_ = 0;
+      emergency_.report(canopen::kEmcyErrorReset, error_register_, kNoMotor);
+      return;
+  }
 }
 
 void Tmcm3216::handle_frame(const can::CanFrame& frame) {
@@ -86,6 +118,10 @@ void Tmcm3216::handle_frame(const can::CanFrame& frame) {
   if (frame.id == canopen::kNmtCobId) {
     nmt_.on_command(frame);
     run_nmt(0);
+    return;
+  }
+  if (frame.id > canopen::kHeartbeatCobIdBase && frame.id <= canopen::kHeartbeatCobIdBase + 127) {
+    heartbeat_consumer_.on_frame(frame);
     return;
   }
   const NmtState state = nmt_.state();

@@ -1,7 +1,8 @@
 // The TMCM-3216 with its CANopen firmware V1.04: the communication area of the object dictionary
 // (manual chapter 3), the node ID and bit rate objects 2704..2708 (4.2.62..4.2.66), NMT with
 // boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
-// memory. PDO, SYNC, EMCY, LSS and the CiA-402 drive follow in later issues; the PDO
+// memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour. PDO, SYNC,
+// LSS and the CiA-402 drive follow in later issues; the PDO
 // communication and mapping parameters are already here, as data, with the manual's defaults.
 #pragma once
 
@@ -14,6 +15,8 @@
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
 #include "core/can/can_frame.h"
+#include "core/canopen/emergency.h"
+#include "core/canopen/heartbeat_consumer.h"
 #include "core/canopen/nmt.h"
 #include "core/canopen/object_dictionary.h"
 #include "core/canopen/sdo_server.h"
@@ -120,6 +123,8 @@ class Tmcm3216 {
   Dictionary& dictionary() { return dictionary_; }
   canopen::NmtSlave& nmt() { return nmt_; }
   canopen::SdoServer& sdo() { return sdo_; }
+  canopen::EmergencyProducer& emergency() { return emergency_; }
+  canopen::HeartbeatConsumer& heartbeat_consumer() { return heartbeat_consumer_; }
   CommunicationConfig& communication() { return communication_; }
   NodeSettings& node_settings() { return node_settings_; }
   const Tmcm3216Config& config() const { return config_; }
@@ -134,6 +139,7 @@ class Tmcm3216 {
   void reset_communication();
   void handle_frame(const can::CanFrame& frame);
   void run_nmt(uint32_t elapsed_us);
+  void run_heartbeat_consumer(uint32_t elapsed_us);
 
   board::NonVolatileMemory& nvm_;
   board::CanController& can_;
@@ -147,6 +153,8 @@ class Tmcm3216 {
   Dictionary dictionary_;
   canopen::NmtSlave nmt_;
   canopen::SdoServer sdo_;
+  canopen::EmergencyProducer emergency_;
+  canopen::HeartbeatConsumer heartbeat_consumer_;
   std::array<uint8_t, kNvmSize> storage_scratch_{};
   canopen::ObjectStorage<Tmcm3216> storage_;
 

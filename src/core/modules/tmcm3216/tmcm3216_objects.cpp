@@ -277,9 +277,13 @@ constexpr Binding sync_cob_id_binding() {
 
 // 1014: bit 31 switches EMCY off; 11-bit identifiers only; the ID does not change while valid.
 constexpr Binding emcy_cob_id_binding() {
-  Binding b = canopen::field_binding<Tmcm3216, [](Tmcm3216& d, uint8_t) -> uint32_t& {
-    return d.communication().emcy_cob_id;
-  }>();
+  Binding b;
+  b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().emcy_cob_id); };
+  b.set = [](Tmcm3216& d, uint8_t, int64_t v) {
+    d.communication().emcy_cob_id = static_cast<uint32_t>(v);
+    d.emergency().set_cob_id(static_cast<uint32_t>(v));
+    return SdoAbort::kNone;
+  };
   b.check = [](Tmcm3216& d, uint8_t, int64_t value) {
     const uint32_t v = static_cast<uint32_t>(value);
     const uint32_t current = d.communication().emcy_cob_id;
@@ -294,9 +298,13 @@ constexpr Binding emcy_cob_id_binding() {
 
 // 1016 sub 1: bits 31..24 reserved, node ID 1..127 in bits 23..16 (or 0: entry unused).
 constexpr Binding consumer_heartbeat_binding() {
-  Binding b = canopen::field_binding<Tmcm3216, [](Tmcm3216& d, uint8_t) -> uint32_t& {
-    return d.communication().consumer_heartbeat[0];
-  }>();
+  Binding b;
+  b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().consumer_heartbeat[0]); };
+  b.set = [](Tmcm3216& d, uint8_t, int64_t v) {
+    d.communication().consumer_heartbeat[0] = static_cast<uint32_t>(v);
+    d.heartbeat_consumer().configure(static_cast<uint32_t>(v));
+    return SdoAbort::kNone;
+  };
   b.check = [](Tmcm3216&, uint8_t, int64_t value) {
     const uint32_t v = static_cast<uint32_t>(value);
     return (v >> 24) != 0 || ((v >> 16) & 0xFF) > 127 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
@@ -481,11 +489,16 @@ constexpr Table build_table() {
             kU32Max, 1, restore_binding<6>()));
   t.add(plus_node_id(var(0x1014, "COB-ID EMCY", kUnsigned32, Access::kRw, 0, kU32Max, 0x80, emcy_cob_id_binding(),
                          kComm)));
-  t.add(var(0x1015, "Inhibit time EMCY", kUnsigned16, Access::kRw, 0, kU16Max, 0,
-            canopen::field_binding<Tmcm3216, [](Tmcm3216& d, uint8_t) -> uint16_t& {
-              return d.communication().emcy_inhibit_100us;
-            }>(),
-            kComm));
+  t.add(var(0x1015, "Inhibit time EMCY", kUnsigned16, Access::kRw, 0, kU16Max, 0, [] {
+              Binding b;
+              b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().emcy_inhibit_100us); };
+              b.set = [](Tmcm3216& d, uint8_t, int64_t v) {
+                d.communication().emcy_inhibit_100us = static_cast<uint16_t>(v);
+                d.emergency().set_inhibit_time_100us(static_cast<uint16_t>(v));
+                return SdoAbort::kNone;
+              };
+              return b;
+            }(), kComm));
   t.add(highest_sub(0x1016, kArray, "Consumer heartbeat time", 1, "Number of entries"));
   t.add(row(0x1016, 1, kArray, "Consumer heartbeat time", "Consumer heartbeat time 1", kUnsigned32, Access::kRw, 0,
             kU32Max, 0, consumer_heartbeat_binding(), kComm));

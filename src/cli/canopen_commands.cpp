@@ -1,0 +1,210 @@
+// `motwin sdo read|write` and `motwin nmt`: a CANopen master on a socketcand endpoint
+// (docs/canopen.md). Exit status 0 on success, 1 when the node aborted the transfer (the abort
+// code and its meaning on stderr), 2 for bad arguments, no connection or no answer.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cli/cli_errors.h"
+#include "cli/commands.h"
+#include "core/canopen/sdo_abort.h"
+#include "host/can_endpoint.h"
+#include "tools/canopen_client.h"
+
+namespace motwin::cli {
+namespace {
+
+constexpr const char* kDefaultCan = "socketcand:127.0.0.1:29536";
+
+struct Target {
+  std::string can = kDefaultCan;
+  int node = 1;
+};
+
+std::unique_ptr<tools::SocketcandClient> connect(const Target& target, int& exit_status) {
+  std::string error;
+  const std::optional<host::CanEndpointSpec> spec = host::parse_can_endpoint(target.can, error);
+  if (!spec || spec->transport != host::CanTransport::kSocketcand) {
+    print_error("--can: " + (spec ? std::string("only socketcand endpoints are supported here") : error));
+    exit_status = kExitUsageError;
+    return nullptr;
+  }
+  tools::SocketcandClient::OpenResult opened = tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
+  if (!opened.client) {
+    print_error(opened.error);
+    exit_status = kExitUsageError;
+  }
+  return std::move(opened.client);
+}
+
+std::optional<uint32_t> parse_unsigned(const std::string& text, int base) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const unsigned long long value = std::strtoull(text.c_str() + (hex ? 2 : 0), &end, hex ? 16 : base);
+  if (*end != '\0' || value > 0xFFFFFFFFull) return std::nullopt;
+  return static_cast<uint32_t>(value);
+}
+
+// TYPE: u8 u16 u32 i8 i16 i32 (numbers), str (visible string), hex (raw bytes).
+int type_size(const std::string& type) {
+  if (type == "u8" || type == "i8") return 1;
+  if (type == "u16" || type == "i16") return 2;
+  if (type == "u32" || type == "i32") return 4;
+  if (type == "str" || type == "hex") return 0;
+  return -1;
+}
+
+std::string format_value(const std::vector<uint8_t>& data, const std::string& type) {
+  if (type == "str") return std::string(data.begin(), data.end());
+  if (type == "hex" || (type.empty() && data.size() > 4)) {
+    std::string out;
+    for (uint8_t b : data) {
+      char byte[4];
+      std::snprintf(byte, sizeof(byte), out.empty() ? "%02X" : " %02X", b);
+      out += byte;
+    }
+    return out;
+  }
+  uint32_t raw = 0;
+  for (size_t i = 0; i < data.size() && i < 4; ++i) raw |= static_cast<uint32_t>(data[i]) << (8 * i);
+  if (type.empty()) {
+    char text[16];
+    std::snprintf(text, sizeof(text), "0x%0*X", static_cast<int>(data.size() * 2), raw);
+    return text;
+  }
+  if (type[0] == 'i') {
+    const int bits = type_size(type) * 8;
+    int64_t value = raw;
+    if (bits < 32 && (raw & (1u << (bits - 1)))) value -= int64_t{1} << bits;
+    if (bits == 32) value = static_cast<int32_t>(raw);
+    return std::to_string(value);
+  }
+  return std::to_string(raw);
+}
+
+int report(const tools::SdoResult& result) {
+  if (result.ok) return kExitSuccess;
+  if (result.abort_code != 0) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "0x%08X", result.abort_code);
+    const std::string meaning = canopen::describe(result.abort_code);
+    print_error(std::string("SDO abort ") + text + (meaning.empty() ? "" : " (" + meaning + ")"));
+    return kExitModuleError;
+  }
+  print_error(result.error);
+  return kExitUsageError;
+}
+
+}  // namespace
+
+void add_canopen_commands(CLI::App& app, int& exit_status) {
+  CLI::App* sdo = app.add_subcommand("sdo", "Read or write an object of a CANopen node over a socketcand endpoint");
+  sdo->require_subcommand(1);
+
+  struct ReadOptions {
+    Target target;
+    std::string index, sub, type;
+  };
+  auto read = std::make_shared<ReadOptions>();
+  CLI::App* read_cmd = sdo->add_subcommand("read", "SDO upload: prints the value");
+  read_cmd->add_option("--can", read->target.can, "Bus endpoint")->type_name("socketcand:HOST:PORT")->capture_default_str();
+  read_cmd->add_option("node", read->target.node, "Node ID")->required()->check(CLI::Range(1, 127));
+  read_cmd->add_option("index", read->index, "Object index in hex (1018 or 0x1018)")->required();
+  read_cmd->add_option("sub", read->sub, "Sub-index (decimal or 0x..)")->required();
+  read_cmd->add_option("type", read->type, "u8 u16 u32 i8 i16 i32 str hex (default: hex number, or bytes)");
+  read_cmd->callback([read, &exit_status] {
+    const std::optional<uint32_t> index = parse_unsigned(read->index, 16);
+    const std::optional<uint32_t> sub = parse_unsigned(read->sub, 10);
+    if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || (!read->type.empty() && type_size(read->type) < 0)) {
+      print_error("expected NODE INDEX SUB [u8|u16|u32|i8|i16|i32|str|hex]");
+      exit_status = kExitUsageError;
+      return;
+    }
+    std::unique_ptr<tools::SocketcandClient> bus = connect(read->target, exit_status);
+    if (!bus) return;
+    const tools::SdoResult result = tools::sdo_upload(*bus, static_cast<uint8_t>(read->target.node),
+                                                      static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub));
+    exit_status = report(result);
+    if (result.ok) std::cout << format_value(result.data, read->type) << '\n';
+  });
+
+  struct WriteOptions {
+    Target target;
+    std::string index, sub, type, value;
+  };
+  auto write = std::make_shared<WriteOptions>();
+  CLI::App* write_cmd = sdo->add_subcommand("write", "SDO download of a value of the given type");
+  write_cmd->add_option("--can", write->target.can, "Bus endpoint")->type_name("socketcand:HOST:PORT")->capture_default_str();
+  write_cmd->add_option("node", write->target.node, "Node ID")->required()->check(CLI::Range(1, 127));
+  write_cmd->add_option("index", write->index, "Object index in hex")->required();
+  write_cmd->add_option("sub", write->sub, "Sub-index")->required();
+  write_cmd->add_option("type", write->type, "u8 u16 u32 i8 i16 i32 str hex")->required();
+  write_cmd->add_option("value", write->value, "Value (decimal or 0x..; text for str; hex digits for hex)")->required();
+  write_cmd->callback([write, &exit_status] {
+    const std::optional<uint32_t> index = parse_unsigned(write->index, 16);
+    const std::optional<uint32_t> sub = parse_unsigned(write->sub, 10);
+    const int size = type_size(write->type);
+    std::vector<uint8_t> data;
+    bool ok = index && *index <= 0xFFFF && sub && *sub <= 0xFF && size >= 0;
+    if (ok && write->type == "str") {
+      data.assign(write->value.begin(), write->value.end());
+    } else if (ok && write->type == "hex") {
+      ok = write->value.size() % 2 == 0 && !write->value.empty();
+      for (size_t i = 0; ok && i < write->value.size(); i += 2) {
+        const std::optional<uint32_t> byte = parse_unsigned(write->value.substr(i, 2), 16);
+        ok = byte.has_value();
+        if (ok) data.push_back(static_cast<uint8_t>(*byte));
+      }
+    } else if (ok) {
+      const std::string& text = write->value;
+      const bool negative = !text.empty() && text[0] == '-';
+      const std::optional<uint32_t> magnitude = parse_unsigned(negative ? text.substr(1) : text, 10);
+      ok = magnitude.has_value() && (!negative || write->type[0] == 'i');
+      const uint32_t raw = ok ? (negative ? static_cast<uint32_t>(-static_cast<int64_t>(*magnitude)) : *magnitude) : 0;
+      for (int i = 0; ok && i < size; ++i) data.push_back(static_cast<uint8_t>(raw >> (8 * i)));
+    }
+    if (!ok) {
+      print_error("expected NODE INDEX SUB TYPE VALUE with TYPE u8|u16|u32|i8|i16|i32|str|hex");
+      exit_status = kExitUsageError;
+      return;
+    }
+    std::unique_ptr<tools::SocketcandClient> bus = connect(write->target, exit_status);
+    if (!bus) return;
+    exit_status = report(tools::sdo_download(*bus, static_cast<uint8_t>(write->target.node),
+                                             static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), data));
+  });
+
+  struct NmtOptions {
+    Target target;
+    std::string command;
+  };
+  auto nmt = std::make_shared<NmtOptions>();
+  CLI::App* nmt_cmd = app.add_subcommand("nmt", "Send an NMT command (node 0: all nodes) over a socketcand endpoint");
+  nmt_cmd->add_option("--can", nmt->target.can, "Bus endpoint")->type_name("socketcand:HOST:PORT")->capture_default_str();
+  nmt_cmd->add_option("command", nmt->command, "start, stop, preop, reset or reset-comm")
+      ->required()
+      ->check(CLI::IsMember({"start", "stop", "preop", "reset", "reset-comm"}));
+  nmt_cmd->add_option("node", nmt->target.node, "Node ID, 0 for all")->required()->check(CLI::Range(0, 127));
+  nmt_cmd->callback([nmt, &exit_status] {
+    const uint8_t code = nmt->command == "start"  ? 0x01
+                         : nmt->command == "stop" ? 0x02
+                         : nmt->command == "preop" ? 0x80
+                         : nmt->command == "reset" ? 0x81
+                                                   : 0x82;
+    std::unique_ptr<tools::SocketcandClient> bus = connect(nmt->target, exit_status);
+    if (!bus) return;
+    const uint8_t data[2] = {code, static_cast<uint8_t>(nmt->target.node)};
+    if (!bus->send(can::make_frame(0x000, data, 2))) {
+      print_error("cannot send to the socketcand server");
+      exit_status = kExitUsageError;
+      return;
+    }
+    exit_status = kExitSuccess;
+  });
+}
+
+}  // namespace motwin::cli

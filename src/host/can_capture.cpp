@@ -1,0 +1,74 @@
+#include "host/can_capture.h"
+
+#include <cerrno>
+#include <cstring>
+
+namespace motwin::host {
+namespace {
+
+void put_u32_le(uint8_t* p, uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<uint8_t>(v >> (8 * i));
+}
+
+}  // namespace
+
+CanCapture::OpenResult CanCapture::open(const std::string& path) {
+  OpenResult result;
+  const bool pcap = path.size() >= 5 && path.compare(path.size() - 5, 5, ".pcap") == 0;
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) {
+    result.error = "cannot create " + path + ": " + std::strerror(errno);
+    return result;
+  }
+  if (pcap) {
+    uint8_t header[24] = {};
+    put_u32_le(header, 0xA1B2C3D4);  // microsecond timestamps, little-endian file
+    header[4] = 2;                   // version 2.4
+    header[6] = 4;
+    put_u32_le(header + 16, 65535);  // snaplen
+    put_u32_le(header + 20, 227);    // LINKTYPE_CAN_SOCKETCAN
+    if (std::fwrite(header, 1, sizeof(header), file) != sizeof(header) || std::fflush(file) != 0) {
+      result.error = "cannot write " + path + ": " + std::strerror(errno);
+      std::fclose(file);
+      return result;
+    }
+  }
+  result.capture.reset(new CanCapture(file, pcap ? Format::kPcap : Format::kCandump));
+  return result;
+}
+
+CanCapture::~CanCapture() { std::fclose(file_); }
+
+void CanCapture::on_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
+  ++frames_;
+  const uint8_t dlc = frame.dlc > 8 ? 8 : frame.dlc;
+  if (format_ == Format::kPcap) {
+    uint8_t record[16 + 16] = {};
+    put_u32_le(record, static_cast<uint32_t>(timestamp_us / 1'000'000u));
+    put_u32_le(record + 4, static_cast<uint32_t>(timestamp_us % 1'000'000u));
+    put_u32_le(record + 8, 16);
+    put_u32_le(record + 12, 16);
+    // struct can_frame with the identifier in network byte order (LINKTYPE_CAN_SOCKETCAN).
+    uint32_t id = frame.id & (frame.extended ? can::kMaxExtendedId : can::kMaxStandardId);
+    if (frame.extended) id |= 0x8000'0000u;
+    if (frame.rtr) id |= 0x4000'0000u;
+    uint8_t* can_frame = record + 16;
+    for (int i = 0; i < 4; ++i) can_frame[i] = static_cast<uint8_t>(id >> (24 - 8 * i));
+    can_frame[4] = dlc;
+    if (!frame.rtr) std::memcpy(can_frame + 8, frame.data, dlc);
+    std::fwrite(record, 1, sizeof(record), file_);
+  } else {
+    std::fprintf(file_, frame.extended ? "(%llu.%06llu) can0 %08X#" : "(%llu.%06llu) can0 %03X#",
+                 static_cast<unsigned long long>(timestamp_us / 1'000'000u),
+                 static_cast<unsigned long long>(timestamp_us % 1'000'000u), static_cast<unsigned>(frame.id));
+    if (frame.rtr) {
+      std::fputc('R', file_);
+    } else {
+      for (uint8_t i = 0; i < dlc; ++i) std::fprintf(file_, "%02X", frame.data[i]);
+    }
+    std::fputc('\n', file_);
+  }
+  std::fflush(file_);
+}
+
+}  // namespace motwin::host

@@ -1,0 +1,53 @@
+// A small CANopen master for the command line (`motwin sdo`, `motwin nmt`): a blocking
+// socketcand client (the same protocol python-can speaks, host/socketcand_server.h) and an SDO
+// client doing expedited and segmented transfers with raw frames.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/can/can_frame.h"
+
+namespace motwin::tools {
+
+class SocketcandClient {
+ public:
+  struct OpenResult {
+    std::unique_ptr<SocketcandClient> client;
+    std::string error;
+  };
+  // Connects, waits for `< hi >`, opens `channel` and enters raw mode.
+  static OpenResult connect(const std::string& host, uint16_t port, int timeout_ms = 2000,
+                            const std::string& channel = "can0");
+  ~SocketcandClient();
+  SocketcandClient(const SocketcandClient&) = delete;
+  SocketcandClient& operator=(const SocketcandClient&) = delete;
+
+  bool send(const can::CanFrame& frame);
+  // The next frame from the bus, or nullopt after `timeout_ms`.
+  std::optional<can::CanFrame> receive(int timeout_ms);
+
+ private:
+  explicit SocketcandClient(int fd) : fd_(fd) {}
+  // The next `< ... >` element's inner text, or nullopt after `timeout_ms`.
+  std::optional<std::string> element(int timeout_ms);
+
+  int fd_;
+  std::string buffer_;
+};
+
+struct SdoResult {
+  bool ok = false;
+  uint32_t abort_code = 0;     // set when the server aborted
+  std::string error;           // set on a timeout or a protocol error (no abort code)
+  std::vector<uint8_t> data;   // upload
+};
+
+SdoResult sdo_upload(SocketcandClient& bus, uint8_t node, uint16_t index, uint8_t sub, int timeout_ms = 1000);
+SdoResult sdo_download(SocketcandClient& bus, uint8_t node, uint16_t index, uint8_t sub,
+                       const std::vector<uint8_t>& data, int timeout_ms = 1000);
+
+}  // namespace motwin::tools

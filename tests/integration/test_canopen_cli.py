@@ -1,0 +1,61 @@
+#!/usr/bin/python3
+"""`motwin sdo read|write` and `motwin nmt` against a running TMCM-3216 on socketcand: values in
+every type, segmented upload of 1008, exit status 1 with the abort code for a refused transfer,
+2 with no answer; an NMT start seen by a python-can observer on the same bus.
+"""
+
+import os
+import subprocess
+import sys
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from canopen_harness import STATE_OPERATIONAL, CanServer, check, check_equal  # noqa: E402
+from motwin_harness import TempDir, run_tests  # noqa: E402
+
+NODE = 12
+
+
+def motwin_run(motwin, *args):
+    result = subprocess.run([motwin, *args], capture_output=True, timeout=30)
+    return result.returncode, result.stdout.decode(), result.stderr.decode()
+
+
+def test_sdo_and_nmt_commands(motwin):
+    with TempDir() as tmp, CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE) as server:
+        can = f"--can=socketcand:127.0.0.1:{server.can_port}"
+
+        def ok(*args):
+            status, out, err = motwin_run(motwin, *args)
+            check_equal(status, 0, f"{args}: exit status (stderr {err!r})")
+            return out.strip()
+
+        check_equal(ok("sdo", "read", can, str(NODE), "1000", "0"), "0xFFFC0192", "1000")
+        check_equal(ok("sdo", "read", can, str(NODE), "0x1018", "2", "u32"), "3216", "1018 sub 2")
+        check_equal(ok("sdo", "read", can, str(NODE), "1008", "0", "str"), "TMCM-3216", "1008 (segmented)")
+        ok("sdo", "write", can, str(NODE), "1017", "0", "u16", "300")
+        check_equal(ok("sdo", "read", can, str(NODE), "1017", "0", "u16"), "300", "1017 read back")
+        ok("sdo", "write", can, str(NODE), "1016", "1", "hex", "E8030500")
+        check_equal(ok("sdo", "read", can, str(NODE), "1016", "1"), "0x000503E8", "1016 sub 1")
+
+        status, _, err = motwin_run(motwin, "sdo", "read", can, str(NODE), "1234", "0")
+        check_equal(status, 1, "exit status of an abort")
+        check("0x06020000" in err and "does not exist" in err, f"stderr {err!r}")
+        status, _, err = motwin_run(motwin, "sdo", "write", can, str(NODE), "1017", "0", "u32", "5")
+        check_equal(status, 1, "exit status of a wrong size")
+        check("0x06070012" in err, f"stderr {err!r}")
+        status, _, err = motwin_run(motwin, "sdo", "read", can, str(NODE + 1), "1000", "0")
+        check_equal(status, 2, "exit status without an answer")
+        status, _, err = motwin_run(motwin, "sdo", "write", can, str(NODE), "1017", "0", "u16", "-5")
+        check_equal(status, 2, "a negative unsigned value")
+
+        with server.bus() as bus:
+            bus.drain(0.1)
+            ok("nmt", can, "start", str(NODE))
+            bus.wait_state(NODE, STATE_OPERATIONAL, timeout=1.0)
+        server.stop()
+
+
+if __name__ == "__main__":
+    run_tests([test_sdo_and_nmt_commands])
