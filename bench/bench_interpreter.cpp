@@ -39,7 +39,7 @@ std::vector<Case> cases() {
       {"calc_ja_loop", "Loop: CALC ADD, 1\n      JA Loop\n"},
       // Through the engine's dispatcher and the parameter table: a read, a compare, a branch.
       {"gap_comp_jc_loop", "Loop: GAP 52, 0\n      COMP 1000\n      JC GE, Loop\n      JA Loop\n"},
-      // Half of the ticks in WAIT (the program costs nothing while it waits).
+      // Almost all the time in WAIT TICKS (10 ms): a waiting program costs next to nothing.
       {"wait_ticks_loop", "Loop: CALC ADD, 1\n      WAIT TICKS, 0, 1\n      JA Loop\n"},
   };
 }
