@@ -22,7 +22,7 @@ class TmclEngine;
 enum class StopReason : uint8_t {
   kNone = 0,
   kStopInstruction,     // STOP
-  kHostStop,            // command 128 or 131
+  kHostStop,            // command 128 (131 clears the reason)
   kJumpOutsideProgram,  // JA/JC/CSUB/VECT target or RETI/RSUB return beyond program memory
   kEndOfMemory,         // the program counter ran past the last address
   kDamagedInstruction,  // a record whose checksum does not match
