@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds Motwin twice (optimised, and with AddressSanitizer + UndefinedBehaviorSanitizer) and
 # runs every test in both builds: unit tests, the freestanding-core check and the integration
-# tests against real peers (python3-serial, sockets, pseudo-terminals).
+# tests against real peers (python3-serial, sockets, pseudo-terminals); then a bounded fuzz run of
+# every libFuzzer target (fuzz/README.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -19,4 +20,6 @@ echo "== tests (optimised build) =="
 ctest --test-dir build -j"$jobs" --output-on-failure || status=1
 echo "== tests (ASan + UBSan build) =="
 ctest --test-dir build-asan -j"$jobs" --output-on-failure || status=1
+echo "== fuzz smoke (libFuzzer + ASan + UBSan, clang, build-fuzz/; scripts/fuzz.sh) =="
+scripts/fuzz.sh --smoke || status=1
 exit $status

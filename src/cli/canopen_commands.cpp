@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/bus_connection.h"
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
 #include "core/canopen/sdo_abort.h"
@@ -17,7 +18,7 @@
 namespace motwin::cli {
 namespace {
 
-constexpr const char* kDefaultCan = "socketcand:127.0.0.1:29536";
+constexpr const char* kDefaultCan = kDefaultCanEndpoint;
 
 struct Target {
   std::string can = kDefaultCan;
@@ -25,19 +26,7 @@ struct Target {
 };
 
 std::unique_ptr<tools::SocketcandClient> connect(const Target& target, int& exit_status) {
-  std::string error;
-  const std::optional<host::CanEndpointSpec> spec = host::parse_can_endpoint(target.can, error);
-  if (!spec || spec->transport != host::CanTransport::kSocketcand) {
-    print_error("--can: " + (spec ? std::string("only socketcand endpoints are supported here") : error));
-    exit_status = kExitUsageError;
-    return nullptr;
-  }
-  tools::SocketcandClient::OpenResult opened = tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
-  if (!opened.client) {
-    print_error(opened.error);
-    exit_status = kExitUsageError;
-  }
-  return std::move(opened.client);
+  return connect_can(target.can, exit_status);
 }
 
 std::optional<uint32_t> parse_unsigned(const std::string& text, int base) {

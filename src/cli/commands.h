@@ -20,5 +20,8 @@ void add_run_command(CLI::App& app, int& exit_status);
 void add_eds_command(CLI::App& app, int& exit_status);
 // `motwin sdo read|write`, `motwin nmt`
 void add_canopen_commands(CLI::App& app, int& exit_status);
+// `motwin candump`, `motwin lss` (src/cli/bus_commands.cpp)
+void add_candump_command(CLI::App& app, int& exit_status);
+void add_lss_command(CLI::App& app, int& exit_status);
 
 }  // namespace motwin::cli

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   motwin::cli::add_run_command(app, exit_status);
   motwin::cli::add_eds_command(app, exit_status);
   motwin::cli::add_canopen_commands(app, exit_status);
+  motwin::cli::add_candump_command(app, exit_status);
+  motwin::cli::add_lss_command(app, exit_status);
   // Usage errors look like every other error and exit with status 2 (CLI11's own codes are
   // 100 and up); --help still exits 0.
   app.failure_message([](const CLI::App*, const CLI::Error& error) {

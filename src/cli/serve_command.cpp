@@ -7,7 +7,12 @@
 //   endpoint tmcl-pty <LINK> </dev/pts/N>         for --tmcl-pty
 //   endpoint can-socketcand 127.0.0.1:<port>      one per --can socketcand:... (CANopen modules)
 //   endpoint can-slcan-tcp 127.0.0.1:<port>       one per --can slcan-tcp:...
+//   endpoint can-slcan-pty <LINK> </dev/pts/N>     one per --can slcan:LINK
+//   endpoint can-socketcan <IFACE>                 one per --can socketcan:IFACE
+// With --node (several modules on one bus) the first line is one line per node instead:
+//   motwin: node <name> <module> (<firmware>) eeprom <path|none>
 //   ready
+//   can-stats frames <n> load <percent>% ...      every --can-stats seconds
 //   output GPO0 1 at <sim seconds>                whenever an output changes
 // Errors before `ready`: one `motwin: error: ...` line on stderr, exit status 2.
 #include <algorithm>
@@ -27,8 +32,10 @@
 #include "cli/commands.h"
 #include "host/can_bus.h"
 #include "host/can_capture.h"
+#include "host/can_device_endpoints.h"
 #include "host/can_endpoint.h"
 #include "host/host_runtime.h"
+#include "host/module_group.h"
 #include "host/module_registry.h"
 #include "host/pacing.h"
 #include "host/pty_endpoint.h"
@@ -58,6 +65,10 @@ struct ServeArguments {
   std::vector<std::string> assignments;
   std::string scenario_path;
   std::string motor = "ideal";
+  std::vector<std::string> nodes;
+  std::string can_bitrate = "1M";
+  double can_stats_s = 0;
+  bool module_given = false;
 };
 
 struct ServeError {
@@ -111,6 +122,41 @@ std::string format_sim_seconds(uint64_t sim_time_us) {
   return buffer;
 }
 
+// "1M", "500k", "125000", "0" (no bus timing).
+std::optional<uint32_t> parse_bit_rate(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  uint64_t multiplier = 1;
+  std::string digits = text;
+  if (digits.back() == 'k' || digits.back() == 'K') multiplier = 1000;
+  if (digits.back() == 'M' || digits.back() == 'm') multiplier = 1'000'000;
+  if (multiplier != 1) digits.pop_back();
+  if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) {
+    return std::nullopt;
+  }
+  const uint64_t value = std::stoull(digits) * multiplier;
+  if (value > 1'000'000) return std::nullopt;  // classic CAN ends at 1 Mbit/s
+  return static_cast<uint32_t>(value);
+}
+
+// One `can-stats` line for the interval since `before` (`interval_us` of simulated time).
+std::string format_can_stats(const host::CanBus& bus, const host::CanBusStats& before, uint64_t interval_us) {
+  const host::CanBusStats& now = bus.stats();
+  const uint64_t frames = now.frames - before.frames;
+  const double load = interval_us == 0 ? 0.0
+                                       : 100.0 * static_cast<double>(now.busy_ns - before.busy_ns) /
+                                             (static_cast<double>(interval_us) * 1000.0);
+  const double mean_delay_ms =
+      frames == 0 ? 0.0 : static_cast<double>(now.total_queue_delay_ns - before.total_queue_delay_ns) / 1e6 /
+                              static_cast<double>(frames);
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "can-stats frames %llu (+%llu) bits %llu load %.1f%% queue-delay mean %.3f ms max %.3f ms bitrate %u",
+                static_cast<unsigned long long>(now.frames), static_cast<unsigned long long>(frames),
+                static_cast<unsigned long long>(now.bits - before.bits), load, mean_delay_ms,
+                static_cast<double>(now.max_queue_delay_ns) / 1e6, bus.bit_rate());
+  return line;
+}
+
 int run_serve(const ServeArguments& arguments) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   ShutdownSignals shutdown_signals;
@@ -162,18 +208,46 @@ int run_serve(const ServeArguments& arguments) {
       throw ServeError{"no home directory for the default state directory; give --state-dir DIR (or none)"};
     }
   }
-  host::MakeModuleResult made = descriptor->make(options);
-  if (!made.module) throw ServeError{made.error};
-  host::VirtualModule& module = *made.module;
-  if (!module.has_tmcl()) {
+  std::vector<host::NodeSpec> node_specs;
+  for (size_t i = 0; i < arguments.nodes.size(); ++i) {
+    const std::optional<host::NodeSpec> spec = host::parse_node_spec(arguments.nodes[i], i + 1, error);
+    if (!spec) throw ServeError{"--node " + arguments.nodes[i] + ": " + error};
+    node_specs.push_back(*spec);
+  }
+  const std::optional<uint32_t> bit_rate = parse_bit_rate(arguments.can_bitrate);
+  if (!bit_rate) throw ServeError{"--can-bitrate: expected bit/s such as 1M, 500k, 125000 or 0, got \"" +
+                                  arguments.can_bitrate + "\""};
+
+  std::unique_ptr<host::VirtualModule> owned_module;
+  host::ModuleGroup* group = nullptr;
+  if (!node_specs.empty()) {
+    // Several modules on one bus: they speak CAN only (docs/canopen.md).
+    if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty() || !arguments.assignments.empty() ||
+        !arguments.scenario_path.empty() || arguments.node_id != 0 || arguments.motor != "ideal" || arguments.module_given) {
+      throw ServeError{"--node cannot be combined with --module, --tmcl-tcp, --tmcl-pty, --set, --scenario, --motor or "
+                       "--node-id (give per-node options: --node tmcm-3216:node-id=2)"};
+    }
+    tcp_specs.clear();
+    if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});
+    host::ModuleGroup::MakeResult made = host::ModuleGroup::make(node_specs, options.state_dir);
+    if (!made.group) throw ServeError{made.error};
+    group = made.group.get();
+    owned_module = std::move(made.group);
+  } else {
+    host::MakeModuleResult made = descriptor->make(options);
+    if (!made.module) throw ServeError{made.error};
+    owned_module = std::move(made.module);
+  }
+  host::VirtualModule& module = *owned_module;
+  if (group == nullptr && !module.has_tmcl()) {
     if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty()) {
       throw ServeError{std::string(module.name()) + " has no TMCL interface (its firmware speaks CANopen): use --can"};
     }
     tcp_specs.clear();
     if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
   }
-  if (!can_specs.empty() && module.can_node() == nullptr) {
-    throw ServeError{std::string(module.name()) + " has no CAN interface yet (--can)"};
+  if (group == nullptr && !can_specs.empty() && module.can_node() == nullptr) {
+    throw ServeError{std::string(module.name()) + " has no CAN interface (--can)"};
   }
 
   host::HostRuntime runtime(module, *pacing);
@@ -193,15 +267,23 @@ int run_serve(const ServeArguments& arguments) {
     if (!opened.endpoint) throw ServeError{opened.error};
     pty = std::move(opened.endpoint);
   }
-  // The virtual CAN bus, stamped with simulated time; the module leaves it before it goes away.
+  // The virtual CAN bus, stamped with simulated time; the modules leave it before they go away.
   host::CanBus can_bus([&module] { return module.sim_time_us(); });
+  can_bus.set_bit_rate(*bit_rate);
   struct BusMembership {
-    host::CanBusNode* node;
+    std::vector<host::CanBusNode*> nodes;
     ~BusMembership() {
-      if (node != nullptr) node->disconnect();
+      for (host::CanBusNode* node : nodes) node->disconnect();
     }
-  } bus_membership{can_specs.empty() ? nullptr : module.can_node()};
-  if (bus_membership.node != nullptr) bus_membership.node->connect(can_bus);
+  } bus_membership;
+  if (!can_specs.empty()) {
+    if (group != nullptr) {
+      for (host::ModuleGroup::Member& member : group->members()) bus_membership.nodes.push_back(member.module->can_node());
+    } else {
+      bus_membership.nodes.push_back(module.can_node());
+    }
+    for (host::CanBusNode* node : bus_membership.nodes) node->connect(can_bus);
+  }
   std::unique_ptr<host::CanCapture> can_capture;
   struct CaptureMembership {
     host::CanBus& bus;
@@ -219,8 +301,25 @@ int run_serve(const ServeArguments& arguments) {
   }
   std::vector<std::unique_ptr<host::SocketcandServer>> can_servers;
   std::vector<std::unique_ptr<host::SlcanTcpServer>> slcan_servers;
+  std::vector<std::unique_ptr<host::SlcanPtyEndpoint>> slcan_ptys;
+  std::vector<std::unique_ptr<host::SocketcanEndpoint>> socketcan_endpoints;
   std::vector<std::string> can_endpoint_lines;
   for (const host::CanEndpointSpec& spec : can_specs) {
+    if (spec.transport == host::CanTransport::kSlcanPty) {
+      host::SlcanPtyEndpoint::OpenResult opened = host::SlcanPtyEndpoint::open(runtime.loop(), can_bus, spec.device);
+      if (!opened.endpoint) throw ServeError{"--can slcan:" + spec.device + ": " + opened.error};
+      can_endpoint_lines.push_back("endpoint can-slcan-pty " + opened.endpoint->link_path() + " " +
+                                   opened.endpoint->device_path());
+      slcan_ptys.push_back(std::move(opened.endpoint));
+      continue;
+    }
+    if (spec.transport == host::CanTransport::kSocketcan) {
+      host::SocketcanEndpoint::OpenResult opened = host::SocketcanEndpoint::open(runtime.loop(), can_bus, spec.device);
+      if (!opened.endpoint) throw ServeError{"--can: " + opened.error};
+      can_endpoint_lines.push_back("endpoint can-socketcan " + opened.endpoint->interface_name());
+      socketcan_endpoints.push_back(std::move(opened.endpoint));
+      continue;
+    }
     if (spec.transport == host::CanTransport::kSlcanTcp) {
       host::SlcanTcpServer::OpenResult opened = host::SlcanTcpServer::open(runtime.loop(), can_bus, spec.tcp);
       if (!opened.server) throw ServeError{"--can: " + opened.error};
@@ -234,6 +333,7 @@ int run_serve(const ServeArguments& arguments) {
     can_servers.push_back(std::move(opened.server));
   }
 
+  std::shared_ptr<std::function<void()>> stats_reporter;
   runtime.set_output_listener([](const sim::OutputChange& change) {
     print_line("output " + std::string(change.signal) + " " + std::to_string(change.level) + " at " +
                format_sim_seconds(change.sim_time_us));
@@ -256,8 +356,28 @@ int run_serve(const ServeArguments& arguments) {
   };
   runtime.loop().add_timer_after(kLagReportIntervalUs, report_lag);
 
-  print_line("motwin: " + std::string(module.name()) + " (" + std::string(module.firmware_version()) + ") eeprom " +
-             module.nvm_location());
+  if (group != nullptr) {
+    for (host::ModuleGroup::Member& member : group->members()) {
+      print_line("motwin: node " + member.name + " " + std::string(member.module->name()) + " (" +
+                 std::string(member.module->firmware_version()) + ") eeprom " + member.module->nvm_location());
+    }
+  } else {
+    print_line("motwin: " + std::string(module.name()) + " (" + std::string(module.firmware_version()) + ") eeprom " +
+               module.nvm_location());
+  }
+  if (arguments.can_stats_s > 0) {
+    if (can_specs.empty()) throw ServeError{"--can-stats needs a CAN bus (--can)"};
+    const uint64_t period_us = static_cast<uint64_t>(arguments.can_stats_s * 1e6);
+    auto previous = std::make_shared<std::pair<host::CanBusStats, uint64_t>>(can_bus.stats(), module.sim_time_us());
+    std::shared_ptr<std::function<void()>> report_stats = std::make_shared<std::function<void()>>();
+    *report_stats = [&runtime, &can_bus, &module, previous, period_us, weak = std::weak_ptr(report_stats)] {
+      print_line(format_can_stats(can_bus, previous->first, module.sim_time_us() - previous->second));
+      *previous = {can_bus.stats(), module.sim_time_us()};
+      if (const auto again = weak.lock()) runtime.loop().add_timer_after(period_us, *again);
+    };
+    stats_reporter = report_stats;
+    runtime.loop().add_timer_after(period_us, *report_stats);
+  }
   for (const auto& server : tcp_servers) print_line("endpoint tmcl-tcp " + server->local_address());
   if (pty) print_line("endpoint tmcl-pty " + pty->link_path() + " " + pty->device_path());
   for (const std::string& line : can_endpoint_lines) print_line(line);
@@ -271,6 +391,8 @@ int run_serve(const ServeArguments& arguments) {
   tcp_servers.clear();
   can_servers.clear();
   slcan_servers.clear();
+  slcan_ptys.clear();
+  socketcan_endpoints.clear();
   return kExitSuccess;
 }
 
@@ -279,9 +401,28 @@ int run_serve(const ServeArguments& arguments) {
 void add_serve_command(CLI::App& app, int& exit_status) {
   auto arguments = std::make_shared<ServeArguments>();
   CLI::App* serve = app.add_subcommand("serve", "Run a virtual module and serve TMCL to host software");
-  serve->add_option("--module", arguments->module, "Module to run: " + host::module_names())
-      ->type_name("NAME")
+  CLI::Option* module_option =
+      serve->add_option("--module", arguments->module, "Module to run: " + host::module_names())
+          ->type_name("NAME")
+          ->capture_default_str();
+  serve->add_option("--node", arguments->nodes,
+                    "Put several modules on one CAN bus in this process instead of --module: "
+                    "MODULE[:KEY=VALUE,...] with keys name (state subdirectory, default MODULE-POSITION), node-id "
+                    "and serial (CANopen), motor, receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
+                    "CAN only. Example: --node tmcm-3216:node-id=1 --node tmcm-3216:node-id=2 --node tmcm-1636")
+      ->type_name("MODULE[:KEY=VALUE,...]")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--can-bitrate", arguments->can_bitrate,
+                    "Bit rate of the virtual bus (1M, 500k, 125000 ...): each frame occupies it for its bit count "
+                    "with stuff bits and is stamped when its last bit is out; a TMCL module whose GP 69 differs is "
+                    "cut off. 0: frames take no time")
+      ->type_name("RATE")
       ->capture_default_str();
+  serve->add_option("--can-stats", arguments->can_stats_s,
+                    "Print a \"can-stats\" line (frames, bus load %, queueing delay) every SECONDS of wall time")
+      ->type_name("SECONDS")
+      ->check(CLI::PositiveNumber);
   serve->add_option("--tmcl-tcp", arguments->tcp_endpoints,
                     "Serve TMCL over TCP (raw 9-byte frames, as PyTrinamic's socket interface sends them) on "
                     "HOST:PORT; HOST defaults to 127.0.0.1, port 0 picks a free port. Repeatable. Without any "
@@ -295,10 +436,12 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("LINK");
   serve->add_option("--can", arguments->can_endpoints,
                     "Put the module on a virtual CAN bus served as socketcand[:HOST]:PORT (python-can's "
-                    "interface='socketcand') or slcan-tcp:[HOST:]PORT (interface='slcan', "
-                    "channel='socket://HOST:PORT'); port 0 picks a free port. Repeatable: all share one bus. "
-                    "CANopen modules (tmcm-3216) default to socketcand:127.0.0.1:29536. See docs/canopen.md")
-      ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT")
+                    "interface='socketcand'), slcan-tcp:[HOST:]PORT (interface='slcan', "
+                    "channel='socket://HOST:PORT'), slcan:LINK (an SLCAN adapter on a pseudo-terminal, LINK a "
+                    "symbolic link to it) or socketcan:IFACE (a Linux CAN interface such as vcan0); port 0 picks a "
+                    "free port. Repeatable: all share one bus. CANopen modules (tmcm-3216) default to "
+                    "socketcand:127.0.0.1:29536; the TMCM-1636 answers TMCL on GP 71/70. See docs/canopen.md")
+      ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT|slcan:LINK|socketcan:IFACE")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   serve->add_option("--can-capture", arguments->can_capture,
@@ -356,7 +499,8 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       "stops the server cleanly (exit status 0); a start-up error exits with status 2.\n" +
       signals_help);
 
-  serve->callback([arguments, &exit_status] {
+  serve->callback([arguments, module_option, &exit_status] {
+    arguments->module_given = module_option->count() > 0;
     try {
       exit_status = run_serve(*arguments);
     } catch (const ServeError& serve_error) {

@@ -2,7 +2,13 @@
 // (socketcand connections, later SLCAN and SocketCAN) attach to it, and every frame one of them
 // sends reaches every other attached endpoint, never the sender itself (a CAN controller does
 // not receive its own frames, and python-canopen's PDO logic is confused by echoes:
-// notes/canopen.md). No arbitration, no bit timing: frames arrive in the order they were sent.
+// notes/canopen.md). Frames arrive in the order they were sent (no arbitration).
+//
+// Bus load: with a bit rate set, each frame occupies the bus for its exact bit count (stuff bits
+// included, host/can_bit_timing.h) starting when the bus is free. Its timestamp is the simulated
+// time its last bit leaves the bus, so back-to-back frames are spaced as on a real bus and an
+// offered load above 100 % shows as a growing queueing delay (stats()). Delivery itself stays
+// immediate in wall time: the stamps and the statistics carry the bus time (docs/canopen.md).
 // Single-threaded, like the rest of the host runtime.
 #pragma once
 
@@ -24,6 +30,14 @@ class CanBusEndpoint {
 
  protected:
   ~CanBusEndpoint() = default;
+};
+
+struct CanBusStats {
+  uint64_t frames = 0;
+  uint64_t bits = 0;                  // stuff bits included
+  uint64_t busy_ns = 0;               // time the bus carried bits
+  uint64_t total_queue_delay_ns = 0;  // sum over frames of (start of transmission - send time)
+  uint64_t max_queue_delay_ns = 0;
 };
 
 class CanBus {
@@ -52,6 +66,11 @@ class CanBus {
   size_t endpoint_count() const;
   uint64_t frame_count() const { return frame_count_; }
 
+  // Bit/s of the bus; 0 (the default): frames take no time and are stamped with the send time.
+  void set_bit_rate(uint32_t bit_rate) { bit_rate_ = bit_rate; }
+  uint32_t bit_rate() const { return bit_rate_; }
+  const CanBusStats& stats() const { return stats_; }
+
  private:
   struct Entry {
     EndpointId id;
@@ -69,6 +88,12 @@ class CanBus {
   EndpointId next_id_ = 1;
   bool delivering_ = false;
   uint64_t frame_count_ = 0;
+  uint32_t bit_rate_ = 0;
+  uint64_t busy_until_ns_ = 0;
+  CanBusStats stats_;
+
+  // The timestamp of a frame sent now: when its transmission ends.
+  uint64_t account(const can::CanFrame& frame);
 };
 
 // A simulated node: a module with a CAN controller. connect() attaches it to a bus; from then on

@@ -58,17 +58,31 @@ void CanCapture::on_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
     if (!frame.rtr) std::memcpy(can_frame + 8, frame.data, dlc);
     std::fwrite(record, 1, sizeof(record), file_);
   } else {
-    std::fprintf(file_, frame.extended ? "(%llu.%06llu) can0 %08X#" : "(%llu.%06llu) can0 %03X#",
-                 static_cast<unsigned long long>(timestamp_us / 1'000'000u),
-                 static_cast<unsigned long long>(timestamp_us % 1'000'000u), static_cast<unsigned>(frame.id));
-    if (frame.rtr) {
-      std::fputc('R', file_);
-    } else {
-      for (uint8_t i = 0; i < dlc; ++i) std::fprintf(file_, "%02X", frame.data[i]);
-    }
+    const std::string line = format_candump_line(frame, timestamp_us);
+    std::fputs(line.c_str(), file_);
     std::fputc('\n', file_);
   }
   std::fflush(file_);
+}
+
+std::string format_candump_line(const can::CanFrame& frame, uint64_t timestamp_us, const std::string& channel) {
+  char head[64];
+  std::snprintf(head, sizeof(head), frame.extended ? "(%llu.%06llu) %s %08X#" : "(%llu.%06llu) %s %03X#",
+                static_cast<unsigned long long>(timestamp_us / 1'000'000u),
+                static_cast<unsigned long long>(timestamp_us % 1'000'000u), channel.c_str(),
+                static_cast<unsigned>(frame.id));
+  std::string line = head;
+  if (frame.rtr) {
+    line += 'R';
+  } else {
+    const uint8_t dlc = frame.dlc > can::kMaxDataLength ? can::kMaxDataLength : frame.dlc;
+    for (uint8_t i = 0; i < dlc; ++i) {
+      char byte[3];
+      std::snprintf(byte, sizeof(byte), "%02X", frame.data[i]);
+      line += byte;
+    }
+  }
+  return line;
 }
 
 }  // namespace motwin::host

@@ -40,4 +40,8 @@ class CanCapture final : public CanBusEndpoint {
   uint64_t frames_ = 0;
 };
 
+// One `candump -L` line without its newline: "(12.000250) can0 601#4000100000000000",
+// "(0.5) can0 12345678#" for an extended ID, "#R" for a remote frame.
+std::string format_candump_line(const can::CanFrame& frame, uint64_t timestamp_us, const std::string& channel = "can0");
+
 }  // namespace motwin::host

@@ -2,11 +2,23 @@
 
 #include <algorithm>
 
+#include "host/tmcl_can_node.h"
+
 namespace motwin::host {
 
 HostRuntime::HostRuntime(VirtualModule& module, Pacing pacing)
     : module_(module), pacer_(pacing, module.tick_period_us()) {
   if (module.has_tmcl()) service_.emplace(module.engine(), loop_);
+  if (TmclCanNode* can = module.tmcl_can_node(); can != nullptr && service_) {
+    can->use_event_channel(service_->open_event_channel(*can));
+  }
+}
+
+HostRuntime::~HostRuntime() {
+  if (TmclCanNode* can = module_.tmcl_can_node(); can != nullptr && service_) {
+    service_->close_event_channel(can->channel());
+    can->use_event_channel(TmclCanNode::kStandaloneChannel);
+  }
 }
 
 void HostRuntime::set_scenario(std::vector<sim::ScenarioEvent> events) {

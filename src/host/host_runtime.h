@@ -29,6 +29,7 @@ class HostRuntime {
   HostRuntime(VirtualModule& module, Pacing pacing);
   HostRuntime(const HostRuntime&) = delete;
   HostRuntime& operator=(const HostRuntime&) = delete;
+  ~HostRuntime();
 
   VirtualModule& module() { return module_; }
   EventLoop& loop() { return loop_; }

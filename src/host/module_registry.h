@@ -31,6 +31,9 @@ struct ModuleOptions {
   std::string motor;
   // CANopen node ID as address switches would set it (`--node-id`, 1..127); 0: the stored one.
   uint8_t node_id = 0;
+  // CANopen identity 1018 sub 4; 0: the module's default (1). Distinct serials tell two
+  // unconfigured modules apart in an LSS fastscan.
+  uint32_t serial_number = 0;
   LogSink log = log_to_stderr;
 };
 

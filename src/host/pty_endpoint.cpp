@@ -1,211 +1,39 @@
 #include "host/pty_endpoint.h"
 
-#include <cerrno>
-#include <climits>
-#include <cstdlib>
-#include <cstring>
-
-#include <fcntl.h>
-#include <sys/ioctl.h>
-#include <sys/stat.h>
-#include <termios.h>
-#include <unistd.h>
-
 namespace motwin::host {
-namespace {
-
-constexpr size_t kReadChunkBytes = 4096;
-// A hangup should not happen while we hold the slave open; if it does, poll() would report it
-// continuously, so reading pauses this long instead of spinning.
-constexpr uint64_t kHangupRetryUs = 100'000;
-
-std::string read_link(const std::string& path) {
-  char target[PATH_MAX];
-  const ssize_t n = ::readlink(path.c_str(), target, sizeof(target) - 1);
-  return n < 0 ? std::string() : std::string(target, static_cast<size_t>(n));
-}
-
-// Empty on success, otherwise why `link_path` cannot be (re)placed.
-std::string place_link(const std::string& link_path, const std::string& device_path) {
-  struct stat existing {};
-  if (::lstat(link_path.c_str(), &existing) == 0) {
-    if (!S_ISLNK(existing.st_mode)) return link_path + " exists and is not a symbolic link; not replacing it";
-    const std::string target = read_link(link_path);
-    struct stat target_info {};
-    const bool stale = ::stat(link_path.c_str(), &target_info) != 0;
-    if (!stale && target.rfind("/dev/pts/", 0) != 0) {
-      return link_path + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it";
-    }
-  } else if (errno != ENOENT) {
-    return "cannot inspect " + link_path + ": " + std::strerror(errno);
-  }
-  // Create beside it and rename over it, so the link is never missing or half made.
-  const std::string temporary = link_path + ".motwin-" + std::to_string(::getpid());
-  ::unlink(temporary.c_str());
-  if (::symlink(device_path.c_str(), temporary.c_str()) != 0) {
-    return "cannot create symbolic link " + link_path + ": " + std::strerror(errno);
-  }
-  if (::rename(temporary.c_str(), link_path.c_str()) != 0) {
-    const int error = errno;
-    ::unlink(temporary.c_str());
-    return "cannot create symbolic link " + link_path + ": " + std::strerror(error);
-  }
-  return {};
-}
-
-}  // namespace
 
 TmclPtyEndpoint::OpenResult TmclPtyEndpoint::open(EventLoop& loop, TmclHostService& service,
                                                   const std::string& link_path, LogSink log) {
   OpenResult result;
-  auto fail = [&](const std::string& what, int master_fd, int slave_fd) {
-    result.error = what;
-    if (slave_fd >= 0) ::close(slave_fd);
-    if (master_fd >= 0) ::close(master_fd);
-    return std::move(result);
-  };
-  if (link_path.empty()) return fail("the pseudo-terminal link path is empty", -1, -1);
-  const int master_fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (master_fd < 0) return fail("cannot create a pseudo-terminal: " + std::string(std::strerror(errno)), -1, -1);
-  char device[PATH_MAX];
-  if (::grantpt(master_fd) != 0 || ::unlockpt(master_fd) != 0 || ::ptsname_r(master_fd, device, sizeof(device)) != 0) {
-    return fail("cannot set up a pseudo-terminal: " + std::string(std::strerror(errno)), master_fd, -1);
-  }
-  const int slave_fd = ::open(device, O_RDWR | O_NOCTTY | O_CLOEXEC);
-  if (slave_fd < 0) {
-    return fail("cannot open " + std::string(device) + ": " + std::strerror(errno), master_fd, -1);
-  }
-  termios settings{};
-  if (::tcgetattr(slave_fd, &settings) == 0) {
-    ::cfmakeraw(&settings);  // no echo, no line editing, no CR/LF translation: bytes pass as they are
-    ::cfsetispeed(&settings, B115200);
-    ::cfsetospeed(&settings, B115200);
-    ::tcsetattr(slave_fd, TCSANOW, &settings);
-  }
-  // Packet mode: each read starts with a status byte, which reports when a client flushes its
-  // input (pyserial does on open): the moment to drop replies nobody will read.
-  const int packet_mode = 1;
-  if (::ioctl(master_fd, TIOCPKT, &packet_mode) != 0) {
-    return fail("cannot set packet mode on the pseudo-terminal: " + std::string(std::strerror(errno)), master_fd,
-                slave_fd);
-  }
-  const int flags = ::fcntl(master_fd, F_GETFL);
-  if (flags < 0 || ::fcntl(master_fd, F_SETFL, flags | O_NONBLOCK) != 0) {
-    return fail("cannot make the pseudo-terminal non-blocking: " + std::string(std::strerror(errno)), master_fd,
-                slave_fd);
-  }
-  if (std::string problem = place_link(link_path, device); !problem.empty()) return fail(problem, master_fd, slave_fd);
-  result.endpoint.reset(new TmclPtyEndpoint(loop, service, master_fd, slave_fd, link_path, device, std::move(log)));
+  const PtyDevice pty = open_pty_device(link_path, result.error);
+  if (pty.master_fd < 0) return result;
+  result.endpoint.reset(new TmclPtyEndpoint(loop, service, pty, link_path, std::move(log)));
   return result;
 }
 
-TmclPtyEndpoint::TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, int master_fd, int slave_fd,
-                                 std::string link_path, std::string device_path, LogSink log)
-    : loop_(loop),
-      service_(service),
-      master_fd_(master_fd),
-      slave_fd_(slave_fd),
-      link_path_(std::move(link_path)),
-      device_path_(std::move(device_path)),
-      log_(std::move(log)) {
+TmclPtyEndpoint::TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, const PtyDevice& device,
+                                 std::string link_path, LogSink log)
+    : service_(service) {
   channel_ = service_.open_channel(*this);
-  loop_.watch(master_fd_, POLLIN, [this](short revents) { on_events(revents); });
+  PtyPort::Handlers handlers;
+  handlers.read_budget = [this] { return service_.input_room(channel_); };
+  // Frames or ASCII lines, whichever mode the link is in (the echo comes back through send_reply).
+  handlers.on_data = [this](const uint8_t* bytes, size_t length) {
+    service_.receive(channel_, bytes, length, monotonic_now_us());
+  };
+  // The client discarded what it was sending: a partial frame or line goes too.
+  handlers.on_flush = [this](bool flushed_output) {
+    if (flushed_output) service_.discard_partial_input(channel_);
+  };
+  port_ = std::make_unique<PtyPort>(loop, device, std::move(link_path), kMaxPendingOutputBytes, std::move(log),
+                                    std::move(handlers));
 }
 
 TmclPtyEndpoint::~TmclPtyEndpoint() {
-  loop_.unwatch(master_fd_);
+  port_.reset();
   service_.close_channel(channel_);
-  // Only our own link: another instance may have taken the name over since.
-  if (read_link(link_path_) == device_path_) ::unlink(link_path_.c_str());
-  ::close(slave_fd_);
-  ::close(master_fd_);
 }
 
-void TmclPtyEndpoint::on_events(short revents) {
-  // Reading first: a flush reported in the status byte must discard stale replies before they
-  // are written into the freshly flushed pty.
-  if ((revents & (POLLIN | POLLPRI)) != 0) {
-    read_some();
-    if ((revents & POLLOUT) != 0) flush();
-  } else if ((revents & POLLOUT) != 0) {
-    flush();
-  } else if ((revents & (POLLHUP | POLLERR)) != 0 && !input_suspended_) {
-    log_("motwin: pseudo-terminal " + device_path_ + " hung up; pausing input");
-    input_suspended_ = true;
-    update_poll_events();
-    loop_.add_timer_after(kHangupRetryUs, [this] {
-      input_suspended_ = false;
-      update_poll_events();
-    });
-  }
-}
-
-void TmclPtyEndpoint::read_some() {
-  const size_t room = service_.input_room(channel_);
-  if (room == 0) return;
-  uint8_t buffer[kReadChunkBytes + 1];
-  ssize_t n = 0;
-  do {
-    n = ::read(master_fd_, buffer, 1 + std::min(kReadChunkBytes, room));
-  } while (n < 0 && errno == EINTR);
-  if (n <= 0) {
-    if (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK) on_events(POLLHUP);
-    return;
-  }
-  const uint8_t status = buffer[0];
-  if (status != TIOCPKT_DATA) {
-    // A status packet carries no data. A client that flushed its input (pyserial on open)
-    // wants no old replies: drop ours, including the tail of one the pty took only in part.
-    if ((status & TIOCPKT_FLUSHREAD) != 0) {
-      output_.clear();
-      reported_dropped_output_ = false;
-    }
-    // It discarded what it was sending: a partial frame or line goes too.
-    if ((status & TIOCPKT_FLUSHWRITE) != 0) service_.discard_partial_input(channel_);
-    update_poll_events();
-    return;
-  }
-  // Frames or ASCII lines, whichever mode the link is in (the echo comes back through send_reply).
-  service_.receive(channel_, buffer + 1, static_cast<size_t>(n - 1), monotonic_now_us());
-  update_poll_events();
-}
-
-void TmclPtyEndpoint::send_reply(const uint8_t* bytes, size_t length) {
-  if (output_.size() + length > kMaxPendingOutputBytes) {
-    if (!reported_dropped_output_) {
-      log_("motwin: nobody reads " + link_path_ + "; dropping replies until someone does");
-      reported_dropped_output_ = true;
-    }
-    return;
-  }
-  output_.insert(output_.end(), bytes, bytes + length);
-  flush();
-}
-
-void TmclPtyEndpoint::flush() {
-  size_t sent = 0;
-  while (sent < output_.size()) {
-    const ssize_t n = ::write(master_fd_, output_.data() + sent, output_.size() - sent);
-    if (n > 0) {
-      sent += static_cast<size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      break;  // the pty is full: the rest goes on POLLOUT
-    } else {
-      sent = output_.size();  // the pty refuses data (EIO): these replies are lost, as on a dead line
-    }
-  }
-  output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(sent));
-  if (output_.empty()) reported_dropped_output_ = false;
-  update_poll_events();
-}
-
-void TmclPtyEndpoint::update_poll_events() {
-  short events = 0;
-  if (!input_suspended_ && service_.has_room(channel_)) events |= POLLIN;
-  if (!output_.empty()) events |= POLLOUT;
-  loop_.set_events(master_fd_, events);
-}
+void TmclPtyEndpoint::send_reply(const uint8_t* bytes, size_t length) { port_->write(bytes, length); }
 
 }  // namespace motwin::host

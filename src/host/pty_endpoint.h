@@ -20,6 +20,7 @@
 
 #include "core/tmcl/serial_link.h"
 #include "host/eeprom_file.h"
+#include "host/pty_device.h"
 #include "host/event_loop.h"
 #include "host/tmcl_host_service.h"
 
@@ -45,33 +46,21 @@ class TmclPtyEndpoint final : public ReplyChannel {
   // Removes the link (if it still points to our pty) and closes the pty.
   ~TmclPtyEndpoint();
 
-  const std::string& link_path() const { return link_path_; }
-  const std::string& device_path() const { return device_path_; }
+  const std::string& link_path() const { return port_->link_path(); }
+  const std::string& device_path() const { return port_->device_path(); }
   tmcl::ChannelId channel() const { return channel_; }
 
   // ReplyChannel.
   void send_reply(const uint8_t* bytes, size_t length) override;
-  void on_request_served() override { update_poll_events(); }
+  void on_request_served() override { port_->update_events(); }
 
  private:
-  TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, int master_fd, int slave_fd, std::string link_path,
-                  std::string device_path, LogSink log);
-  void on_events(short revents);
-  void read_some();
-  void flush();
-  void update_poll_events();
+  TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, const PtyDevice& device, std::string link_path,
+                  LogSink log);
 
-  EventLoop& loop_;
   TmclHostService& service_;
-  int master_fd_;
-  int slave_fd_;
-  std::string link_path_;
-  std::string device_path_;
-  LogSink log_;
   tmcl::ChannelId channel_ = 0;
-  std::vector<uint8_t> output_;
-  bool input_suspended_ = false;      // after an unexpected hangup, see on_events()
-  bool reported_dropped_output_ = false;
+  std::unique_ptr<PtyPort> port_;
 };
 
 }  // namespace motwin::host

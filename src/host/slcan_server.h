@@ -6,7 +6,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <string>
 
@@ -16,6 +15,8 @@
 #include "host/tcp_server.h"
 
 namespace motwin::host {
+
+class TcpConnectionServer;
 
 class SlcanTcpServer {
  public:
@@ -34,20 +35,13 @@ class SlcanTcpServer {
 
   std::string local_address() const;
   uint16_t local_port() const;
-  size_t client_count() const { return connections_.size(); }
+  size_t client_count() const;
 
  private:
-  class Connection;
-  SlcanTcpServer(EventLoop& loop, CanBus& bus, int listen_fd, LogSink log);
-  void accept_clients();
-  void close_connection(Connection& connection, const std::string& reason);
+  class Session;
+  SlcanTcpServer() = default;
 
-  EventLoop& loop_;
-  CanBus& bus_;
-  int listen_fd_;
-  LogSink log_;
-  uint64_t next_connection_id_ = 1;
-  std::map<uint64_t, std::shared_ptr<Connection>> connections_;
+  std::unique_ptr<TcpConnectionServer> connections_;
 };
 
 }  // namespace motwin::host

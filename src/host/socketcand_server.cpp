@@ -1,86 +1,46 @@
 #include "host/socketcand_server.h"
 
-#include <cerrno>
-#include <cstring>
 #include <vector>
 
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
-#include "host/can_endpoint.h"
 #include "host/socketcand_protocol.h"
+#include "host/tcp_connection_server.h"
 
 namespace motwin::host {
-namespace {
 
-constexpr uint64_t kAcceptRetryUs = 100'000;
-constexpr size_t kReadChunkBytes = 4096;
-
-}  // namespace
-
-class SocketcandServer::Connection final : public CanBusEndpoint {
+// One client: a bus endpoint from the moment it is connected, seeing frames in raw mode.
+class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint {
  public:
   enum class Mode : uint8_t { kAwaitOpen, kBcm, kRaw };
 
-  Connection(SocketcandServer& server, uint64_t id, int fd, std::string peer)
-      : server_(server), id_(id), fd_(fd), peer_(std::move(peer)) {}
-  Connection(const Connection&) = delete;
-  Connection& operator=(const Connection&) = delete;
-  ~Connection() { ::close(fd_); }
+  Session(CanBus& bus, std::weak_ptr<bool> server_alive, TcpConnectionServer& server)
+      : bus_(bus), server_alive_(std::move(server_alive)), server_(server) {}
 
-  uint64_t id() const { return id_; }
-  int fd() const { return fd_; }
-  const std::string& peer() const { return peer_; }
-  bool closing() const { return closing_; }
-  CanBus::EndpointId bus_id() const { return bus_id_; }
-  void set_bus_id(CanBus::EndpointId id) { bus_id_ = id; }
+  void on_open() override {
+    bus_id_ = bus_.attach(*this);
+    connection().write("< hi >");
+  }
 
-  void start() { write("< hi >"); }
-
-  void mark_closing() {
-    closing_ = true;
-    if (bus_id_ != 0) server_.bus_.detach(bus_id_);
+  void on_close() override {
+    if (bus_id_ != 0) bus_.detach(bus_id_);
     bus_id_ = 0;
   }
 
-  void on_events(short revents) {
-    if ((revents & POLLOUT) != 0) flush();
-    if (closing_) return;
-    if ((revents & (POLLIN | POLLHUP | POLLERR)) != 0) read_some();
-  }
-
-  // CanBusEndpoint.
-  void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override {
-    if (closing_ || mode_ != Mode::kRaw) return;
-    write(format_socketcand_frame(frame, timestamp_us));
-  }
-
- private:
-  void read_some() {
-    char buffer[kReadChunkBytes];
-    ssize_t n = 0;
-    do {
-      n = ::recv(fd_, buffer, sizeof(buffer), 0);
-    } while (n < 0 && errno == EINTR);
-    if (n < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK) return;
-      server_.close_connection(*this, std::strerror(errno));
-      return;
-    }
-    if (n == 0) {
-      server_.close_connection(*this, "closed by the client");
-      return;
-    }
+  void on_data(const uint8_t* bytes, size_t length) override {
     elements_.clear();
-    parser_.push(std::string_view(buffer, static_cast<size_t>(n)), elements_);
+    parser_.push(std::string_view(reinterpret_cast<const char*>(bytes), length), elements_);
     for (const std::string& element : elements_) {
-      if (closing_) return;
+      if (connection().closing()) return;
       handle(element);
     }
   }
 
+  // CanBusEndpoint.
+  void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override {
+    if (connection().closing() || mode_ != Mode::kRaw) return;
+    connection().write(format_socketcand_frame(frame, timestamp_us));
+  }
+
+ private:
   void handle(const std::string& element) {
     const std::vector<std::string_view> words = socketcand_words(element);
     const std::string_view command = words.empty() ? std::string_view{} : words[0];
@@ -88,7 +48,7 @@ class SocketcandServer::Connection final : public CanBusEndpoint {
       case Mode::kAwaitOpen:
         if (command == "open" && words.size() == 2) {
           mode_ = Mode::kBcm;
-          write("< ok >");
+          connection().write("< ok >");
         } else {
           error("expected open");
         }
@@ -102,17 +62,17 @@ class SocketcandServer::Connection final : public CanBusEndpoint {
             error(problem);
             return;
           }
-          server_.bus_.send(bus_id_, *frame);
+          bus_.send(bus_id_, *frame);
         } else if (command == "rawmode" && words.size() == 1) {
           const bool entering = mode_ != Mode::kRaw;
           mode_ = Mode::kRaw;
-          write("< ok >");
+          connection().write("< ok >");
           if (entering) hold_output();
         } else if (command == "bcmmode" && words.size() == 1) {
           mode_ = Mode::kBcm;
-          write(" < ok >");
+          connection().write(" < ok >");
         } else if (command == "echo" && words.size() == 1) {
-          write(" < echo >");
+          connection().write(" < echo >");
         } else {
           error("unknown command");
         }
@@ -120,156 +80,54 @@ class SocketcandServer::Connection final : public CanBusEndpoint {
     }
   }
 
-  void error(const std::string& text) { write(" < error " + text + " >"); }
+  void error(const std::string& text) { connection().write(" < error " + text + " >"); }
 
   // python-can compares the `< ok >` of rawmode with one recv(): nothing may follow it closely.
   void hold_output() {
-    held_ = true;
-    std::weak_ptr<bool> alive = server_.lifetime_;
-    const uint64_t id = id_;
-    SocketcandServer* server = &server_;
-    server_.loop_.add_timer_after(kRawModeSettleUs, [alive, server, id] {
+    connection().hold_output(true);
+    std::weak_ptr<bool> alive = server_alive_;
+    TcpConnectionServer* server = &server_;
+    const uint64_t id = connection().id();
+    server_.loop().add_timer_after(kRawModeSettleUs, [alive, server, id] {
       if (alive.expired()) return;
-      const auto found = server->connections_.find(id);
-      if (found == server->connections_.end()) return;
-      found->second->held_ = false;
-      found->second->flush();
+      if (TcpConnection* connection = server->find(id)) connection->hold_output(false);
     });
   }
 
-  void write(const std::string& text) {
-    if (closing_) return;
-    if (output_.size() - output_sent_ + text.size() > kMaxPendingOutputBytes) {
-      server_.close_connection(*this, "it does not read its frames");
-      return;
-    }
-    output_ += text;
-    // Each element in its own send(): python-can reads the greeting and each `< ok >` alone.
-    flush();
-  }
-
-  void flush() {
-    while (!held_ && output_sent_ < output_.size()) {
-      const ssize_t n = ::send(fd_, output_.data() + output_sent_, output_.size() - output_sent_,
-                               MSG_NOSIGNAL | MSG_DONTWAIT);
-      if (n > 0) {
-        output_sent_ += static_cast<size_t>(n);
-      } else if (n < 0 && errno == EINTR) {
-        continue;
-      } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-        break;
-      } else {
-        server_.close_connection(*this, n < 0 ? std::strerror(errno) : "send failed");
-        return;
-      }
-    }
-    if (output_sent_ == output_.size()) {
-      output_.clear();
-      output_sent_ = 0;
-    } else if (output_sent_ > 64 * 1024) {
-      output_.erase(0, output_sent_);
-      output_sent_ = 0;
-    }
-    if (closing_) return;
-    server_.loop_.set_events(fd_, static_cast<short>(POLLIN | (!held_ && output_sent_ < output_.size() ? POLLOUT : 0)));
-  }
-
-  SocketcandServer& server_;
-  uint64_t id_;
-  int fd_;
-  std::string peer_;
+  CanBus& bus_;
+  std::weak_ptr<bool> server_alive_;
+  TcpConnectionServer& server_;
   CanBus::EndpointId bus_id_ = 0;
   Mode mode_ = Mode::kAwaitOpen;
   SocketcandElementParser parser_;
   std::vector<std::string> elements_;
-  std::string output_;
-  size_t output_sent_ = 0;
-  bool held_ = false;
-  bool closing_ = false;
 };
 
 SocketcandServer::OpenResult SocketcandServer::open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
                                                     LogSink log) {
   OpenResult result;
-  const int fd = listen_tcp(spec, result.error);
-  if (fd < 0) return result;
-  result.server.reset(new SocketcandServer(loop, bus, fd, std::move(log)));
+  std::unique_ptr<SocketcandServer> server(new SocketcandServer());
+  SocketcandServer* raw = server.get();
+  TcpConnectionServer::Config config{"socketcand", kMaxClients, kMaxPendingOutputBytes, "it does not read its frames"};
+  TcpConnectionServer::OpenResult opened = TcpConnectionServer::open(
+      loop, spec, std::move(config),
+      [&bus, raw](TcpConnection&) -> std::unique_ptr<TcpSession> {
+        return std::make_unique<Session>(bus, raw->connections_->lifetime(), *raw->connections_);
+      },
+      std::move(log));
+  if (!opened.server) {
+    result.error = opened.error;
+    return result;
+  }
+  server->connections_ = std::move(opened.server);
+  result.server = std::move(server);
   return result;
 }
 
-SocketcandServer::SocketcandServer(EventLoop& loop, CanBus& bus, int listen_fd, LogSink log)
-    : loop_(loop), bus_(bus), listen_fd_(listen_fd), log_(std::move(log)) {
-  loop_.watch(listen_fd_, POLLIN, [this](short) { accept_clients(); });
-}
+SocketcandServer::~SocketcandServer() = default;
 
-SocketcandServer::~SocketcandServer() {
-  for (auto& [id, connection] : connections_) {
-    loop_.unwatch(connection->fd());
-    connection->mark_closing();
-  }
-  connections_.clear();
-  loop_.unwatch(listen_fd_);
-  ::close(listen_fd_);
-}
-
-std::string SocketcandServer::local_address() const {
-  sockaddr_storage address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
-  return format_socket_address(address);
-}
-
-uint16_t SocketcandServer::local_port() const {
-  sockaddr_storage address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
-  if (address.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in&>(address).sin_port);
-  return ntohs(reinterpret_cast<const sockaddr_in6&>(address).sin6_port);
-}
-
-void SocketcandServer::accept_clients() {
-  for (;;) {
-    sockaddr_storage address{};
-    socklen_t length = sizeof(address);
-    const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length, SOCK_NONBLOCK | SOCK_CLOEXEC);
-    if (fd < 0) {
-      if (errno == EINTR || errno == ECONNABORTED || errno == EPROTO) continue;
-      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-        log_("motwin: cannot accept a socketcand client: " + std::string(std::strerror(errno)) + "; retrying shortly");
-        loop_.set_events(listen_fd_, 0);
-        loop_.add_timer_after(kAcceptRetryUs, [this] { loop_.set_events(listen_fd_, POLLIN); });
-      }
-      return;
-    }
-    const std::string peer = format_socket_address(address);
-    if (connections_.size() >= kMaxClients) {
-      log_("motwin: refusing socketcand client " + peer + ": already " + std::to_string(kMaxClients) + " clients");
-      ::close(fd);
-      continue;
-    }
-    const int on = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
-    const uint64_t id = next_connection_id_++;
-    auto connection = std::make_shared<Connection>(*this, id, fd, peer);
-    connections_[id] = connection;
-    Connection* raw = connection.get();
-    loop_.watch(fd, POLLIN, [raw](short revents) { raw->on_events(revents); });
-    raw->set_bus_id(bus_.attach(*raw));
-    log_("motwin: socketcand client " + peer + " connected");
-    raw->start();
-  }
-}
-
-void SocketcandServer::close_connection(Connection& connection, const std::string& reason) {
-  if (connection.closing()) return;
-  connection.mark_closing();
-  loop_.unwatch(connection.fd());
-  log_("motwin: socketcand client " + connection.peer() + " disconnected (" + reason + ")");
-  const auto found = connections_.find(connection.id());
-  if (found == connections_.end()) return;
-  std::shared_ptr<Connection> keep_alive = std::move(found->second);
-  connections_.erase(found);
-  loop_.defer([keep_alive] {});
-}
+std::string SocketcandServer::local_address() const { return connections_->local_address(); }
+uint16_t SocketcandServer::local_port() const { return connections_->local_port(); }
+size_t SocketcandServer::client_count() const { return connections_->client_count(); }
 
 }  // namespace motwin::host

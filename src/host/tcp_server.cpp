@@ -13,14 +13,10 @@
 #include <unistd.h>
 
 #include "core/tmcl/serial_link.h"
+#include "host/tcp_connection_server.h"
 
 namespace motwin::host {
 namespace {
-
-// While the process is out of descriptors, accepting is retried this much later instead of
-// spinning on a listening socket that stays readable.
-constexpr uint64_t kAcceptRetryUs = 100'000;
-constexpr size_t kReadChunkBytes = 4096;
 
 std::optional<uint16_t> parse_port(std::string_view text) {
   unsigned value = 0;
@@ -57,146 +53,7 @@ std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::st
   return spec;
 }
 
-std::string format_socket_address(const sockaddr_storage& address) {
-  char host[INET6_ADDRSTRLEN] = "?";
-  uint16_t port = 0;
-  if (address.ss_family == AF_INET) {
-    const auto& ipv4 = reinterpret_cast<const sockaddr_in&>(address);
-    ::inet_ntop(AF_INET, &ipv4.sin_addr, host, sizeof(host));
-    port = ntohs(ipv4.sin_port);
-    return std::string(host) + ":" + std::to_string(port);
-  }
-  if (address.ss_family == AF_INET6) {
-    const auto& ipv6 = reinterpret_cast<const sockaddr_in6&>(address);
-    ::inet_ntop(AF_INET6, &ipv6.sin6_addr, host, sizeof(host));
-    port = ntohs(ipv6.sin6_port);
-  }
-  return "[" + std::string(host) + "]:" + std::to_string(port);
-}
-
-// One client connection: a frame decoder on the way in, a bounded buffer on the way out.
-class TmclTcpServer::Connection final : public ReplyChannel {
- public:
-  Connection(TmclTcpServer& server, int fd, std::string peer) : server_(server), fd_(fd), peer_(std::move(peer)) {}
-  Connection(const Connection&) = delete;
-  Connection& operator=(const Connection&) = delete;
-  ~Connection() { ::close(fd_); }
-
-  int fd() const { return fd_; }
-  const std::string& peer() const { return peer_; }
-  tmcl::ChannelId channel() const { return channel_; }
-  void set_channel(tmcl::ChannelId channel) { channel_ = channel; }
-  bool closing() const { return closing_; }
-  void mark_closing() { closing_ = true; }
-
-  void on_events(short revents) {
-    if ((revents & POLLOUT) != 0) flush();
-    if (closing_) return;
-    if ((revents & (POLLIN | POLLHUP | POLLERR)) == 0) return;
-    if (!wants_input()) {
-      // Not reading (queue full or input closed) yet the socket failed: nothing left to wait for.
-      if ((revents & (POLLHUP | POLLERR)) != 0) server_.close_connection(*this, "connection lost");
-      return;
-    }
-    read_some();
-  }
-
-  void send_reply(const uint8_t* bytes, size_t length) override {
-    if (closing_) return;
-    if (output_.size() - output_sent_ + length > kMaxPendingOutputBytes) {
-      server_.close_connection(*this, "it does not read its replies");
-      return;
-    }
-    output_.insert(output_.end(), bytes, bytes + length);
-    flush();
-  }
-
-  void on_request_served() override {
-    if (closing_) return;
-    update_poll_events();
-    close_if_finished();
-  }
-
- private:
-  bool wants_input() const { return !input_closed_ && server_.service_.has_room(channel_); }
-
-  void read_some() {
-    // Read no more than the service takes, so the rest waits in the kernel (back-pressure).
-    uint8_t buffer[kReadChunkBytes];
-    const size_t budget = std::min(sizeof(buffer), server_.service_.input_room(channel_));
-    if (budget == 0) return;
-    ssize_t n = 0;
-    do {
-      n = ::recv(fd_, buffer, budget, 0);
-    } while (n < 0 && errno == EINTR);
-    if (n < 0) {
-      if (errno == EAGAIN || errno == EWOULDBLOCK) return;
-      server_.close_connection(*this, std::strerror(errno));
-      return;
-    }
-    if (n == 0) {
-      // The client is done sending; replies to what it sent still go out before we close.
-      input_closed_ = true;
-      update_poll_events();
-      close_if_finished();
-      return;
-    }
-    // Frames or ASCII lines, whichever mode this connection is in; the echo of ASCII mode may
-    // come back through send_reply() (and close us if we cannot take it).
-    server_.service_.receive(channel_, buffer, static_cast<size_t>(n), monotonic_now_us());
-    update_poll_events();
-  }
-
-  void flush() {
-    while (output_sent_ < output_.size()) {
-      const ssize_t n = ::send(fd_, output_.data() + output_sent_, output_.size() - output_sent_,
-                               MSG_NOSIGNAL | MSG_DONTWAIT);
-      if (n > 0) {
-        output_sent_ += static_cast<size_t>(n);
-      } else if (n < 0 && errno == EINTR) {
-        continue;
-      } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-        break;
-      } else {
-        server_.close_connection(*this, n < 0 ? std::strerror(errno) : "send failed");
-        return;
-      }
-    }
-    if (output_sent_ == output_.size()) {
-      output_.clear();
-      output_sent_ = 0;
-    }
-    update_poll_events();
-    close_if_finished();
-  }
-
-  void update_poll_events() {
-    if (closing_) return;
-    short events = 0;
-    if (wants_input()) events |= POLLIN;
-    if (output_sent_ < output_.size()) events |= POLLOUT;
-    server_.loop_.set_events(fd_, events);
-  }
-
-  void close_if_finished() {
-    if (closing_ || !input_closed_ || output_sent_ < output_.size()) return;
-    if (server_.service_.queued_requests(channel_) != 0 || server_.service_.reply_held_for(channel_)) return;
-    server_.close_connection(*this, "closed by the client");
-  }
-
-  TmclTcpServer& server_;
-  int fd_;
-  std::string peer_;
-  tmcl::ChannelId channel_ = 0;
-  std::vector<uint8_t> output_;
-  size_t output_sent_ = 0;
-  bool input_closed_ = false;
-  bool closing_ = false;
-};
-
-TmclTcpServer::OpenResult TmclTcpServer::open(EventLoop& loop, TmclHostService& service, const TcpEndpointSpec& spec,
-                                              LogSink log) {
-  OpenResult result;
+int listen_tcp(const TcpEndpointSpec& spec, std::string& error) {
   const std::string where = (spec.host.find(':') != std::string::npos ? "[" + spec.host + "]" : spec.host) + ":" +
                             std::to_string(spec.port);
   addrinfo hints{};
@@ -206,8 +63,8 @@ TmclTcpServer::OpenResult TmclTcpServer::open(EventLoop& loop, TmclHostService& 
   addrinfo* addresses = nullptr;
   const std::string port_text = std::to_string(spec.port);
   if (const int status = ::getaddrinfo(spec.host.c_str(), port_text.c_str(), &hints, &addresses); status != 0) {
-    result.error = "cannot listen on " + where + ": " + ::gai_strerror(status);
-    return result;
+    error = "cannot listen on " + where + ": " + ::gai_strerror(status);
+    return -1;
   }
   int listen_fd = -1;
   int last_errno = 0;
@@ -227,96 +84,95 @@ TmclTcpServer::OpenResult TmclTcpServer::open(EventLoop& loop, TmclHostService& 
     listen_fd = fd;
   }
   ::freeaddrinfo(addresses);
-  if (listen_fd < 0) {
-    result.error = "cannot listen on " + where + ": " + std::strerror(last_errno);
+  if (listen_fd < 0) error = "cannot listen on " + where + ": " + std::strerror(last_errno);
+  return listen_fd;
+}
+
+std::string format_socket_address(const sockaddr_storage& address) {
+  char host[INET6_ADDRSTRLEN] = "?";
+  uint16_t port = 0;
+  if (address.ss_family == AF_INET) {
+    const auto& ipv4 = reinterpret_cast<const sockaddr_in&>(address);
+    ::inet_ntop(AF_INET, &ipv4.sin_addr, host, sizeof(host));
+    port = ntohs(ipv4.sin_port);
+    return std::string(host) + ":" + std::to_string(port);
+  }
+  if (address.ss_family == AF_INET6) {
+    const auto& ipv6 = reinterpret_cast<const sockaddr_in6&>(address);
+    ::inet_ntop(AF_INET6, &ipv6.sin6_addr, host, sizeof(host));
+    port = ntohs(ipv6.sin6_port);
+  }
+  return "[" + std::string(host) + "]:" + std::to_string(port);
+}
+
+// One client: a TMCL channel of the service (frame decoder or ASCII lines) on the way in, the
+// connection's bounded buffer on the way out.
+class TmclTcpServer::Session final : public TcpSession, public ReplyChannel {
+ public:
+  explicit Session(TmclHostService& service) : service_(service) {}
+
+  void on_open() override { channel_ = service_.open_channel(*this, kResyncGapUs); }
+
+  // Read no more than the service takes, so the rest waits in the kernel (back-pressure).
+  size_t read_budget() const override { return input_closed_ ? 0 : service_.input_room(channel_); }
+
+  void on_data(const uint8_t* bytes, size_t length) override {
+    // Frames or ASCII lines, whichever mode this connection is in; the echo of ASCII mode may
+    // come back through send_reply() (and close us if we cannot take it).
+    service_.receive(channel_, bytes, length, monotonic_now_us());
+  }
+
+  void on_input_closed() override {
+    // The client is done sending; replies to what it sent still go out before we close.
+    input_closed_ = true;
+    connection().update_events();
+    close_if_finished();
+  }
+
+  void on_output_drained() override { close_if_finished(); }
+  void on_close() override { service_.close_channel(channel_); }
+
+  // ReplyChannel.
+  void send_reply(const uint8_t* bytes, size_t length) override { connection().write(bytes, length); }
+  void on_request_served() override {
+    if (connection().closing()) return;
+    connection().update_events();
+    close_if_finished();
+  }
+
+ private:
+  void close_if_finished() {
+    if (connection().closing() || !input_closed_ || connection().pending_output() > 0) return;
+    if (service_.queued_requests(channel_) != 0 || service_.reply_held_for(channel_)) return;
+    connection().close("closed by the client");
+  }
+
+  TmclHostService& service_;
+  tmcl::ChannelId channel_ = 0;
+  bool input_closed_ = false;
+};
+
+TmclTcpServer::OpenResult TmclTcpServer::open(EventLoop& loop, TmclHostService& service, const TcpEndpointSpec& spec,
+                                              LogSink log) {
+  OpenResult result;
+  TcpConnectionServer::Config config{"TCP", kMaxClients, kMaxPendingOutputBytes, "it does not read its replies"};
+  TcpConnectionServer::OpenResult opened = TcpConnectionServer::open(
+      loop, spec, std::move(config),
+      [&service](TcpConnection&) -> std::unique_ptr<TcpSession> { return std::make_unique<Session>(service); },
+      std::move(log));
+  if (!opened.server) {
+    result.error = opened.error;
     return result;
   }
-  result.server.reset(new TmclTcpServer(loop, service, listen_fd, std::move(log)));
+  result.server.reset(new TmclTcpServer());
+  result.server->connections_ = std::move(opened.server);
   return result;
 }
 
-TmclTcpServer::TmclTcpServer(EventLoop& loop, TmclHostService& service, int listen_fd, LogSink log)
-    : loop_(loop), service_(service), listen_fd_(listen_fd), log_(std::move(log)) {
-  loop_.watch(listen_fd_, POLLIN, [this](short) { accept_clients(); });
-}
+TmclTcpServer::~TmclTcpServer() = default;
 
-TmclTcpServer::~TmclTcpServer() {
-  for (auto& [channel, connection] : connections_) {
-    loop_.unwatch(connection->fd());
-    service_.close_channel(channel);
-    connection->mark_closing();
-  }
-  connections_.clear();
-  loop_.unwatch(listen_fd_);
-  ::close(listen_fd_);
-}
-
-std::string TmclTcpServer::local_address() const {
-  sockaddr_storage address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
-  return format_socket_address(address);
-}
-
-uint16_t TmclTcpServer::local_port() const {
-  sockaddr_storage address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
-  if (address.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in&>(address).sin_port);
-  return ntohs(reinterpret_cast<const sockaddr_in6&>(address).sin6_port);
-}
-
-void TmclTcpServer::accept_clients(bool after_other_callbacks) {
-  for (;;) {
-    if (connections_.size() >= kMaxClients && !after_other_callbacks) {
-      std::weak_ptr<bool> alive = lifetime_;
-      loop_.defer([this, alive] {
-        if (!alive.expired()) accept_clients(true);
-      });
-      return;
-    }
-    sockaddr_storage address{};
-    socklen_t length = sizeof(address);
-    const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length, SOCK_NONBLOCK | SOCK_CLOEXEC);
-    if (fd < 0) {
-      if (errno == EINTR || errno == ECONNABORTED || errno == EPROTO) continue;
-      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
-        log_("motwin: cannot accept a TCP client: " + std::string(std::strerror(errno)) + "; retrying shortly");
-        loop_.set_events(listen_fd_, 0);
-        loop_.add_timer_after(kAcceptRetryUs, [this] { loop_.set_events(listen_fd_, POLLIN); });
-      }
-      return;  // EAGAIN: all accepted
-    }
-    const std::string peer = format_socket_address(address);
-    if (connections_.size() >= kMaxClients) {
-      log_("motwin: refusing TCP client " + peer + ": already " + std::to_string(kMaxClients) + " clients");
-      ::close(fd);
-      continue;
-    }
-    const int on = 1;
-    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));  // replies are 9 bytes: no Nagle delay
-    auto connection = std::make_shared<Connection>(*this, fd, peer);
-    const tmcl::ChannelId channel = service_.open_channel(*connection, kResyncGapUs);
-    connection->set_channel(channel);
-    connections_[channel] = connection;
-    Connection* raw = connection.get();
-    loop_.watch(fd, POLLIN, [raw](short revents) { raw->on_events(revents); });
-    log_("motwin: TCP client " + peer + " connected");
-  }
-}
-
-void TmclTcpServer::close_connection(Connection& connection, const std::string& reason) {
-  if (connection.closing()) return;
-  connection.mark_closing();
-  loop_.unwatch(connection.fd());
-  service_.close_channel(connection.channel());
-  log_("motwin: TCP client " + connection.peer() + " disconnected (" + reason + ")");
-  const auto found = connections_.find(connection.channel());
-  if (found == connections_.end()) return;
-  // Its member functions may be on the stack right now: destroy it after this dispatch.
-  std::shared_ptr<Connection> keep_alive = std::move(found->second);
-  connections_.erase(found);
-  loop_.defer([keep_alive] {});
-}
+std::string TmclTcpServer::local_address() const { return connections_->local_address(); }
+uint16_t TmclTcpServer::local_port() const { return connections_->local_port(); }
+size_t TmclTcpServer::client_count() const { return connections_->client_count(); }
 
 }  // namespace motwin::host

@@ -6,7 +6,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -30,6 +29,8 @@ struct TcpEndpointSpec {
 
 // "HOST:PORT", ":PORT", "PORT" (host 127.0.0.1) or "[IPv6]:PORT". On failure sets `error`.
 std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::string& error);
+
+class TcpConnectionServer;
 
 class TmclTcpServer {
  public:
@@ -55,24 +56,18 @@ class TmclTcpServer {
 
   std::string local_address() const;  // "127.0.0.1:40321", "[::1]:5000"
   uint16_t local_port() const;
-  size_t client_count() const { return connections_.size(); }
+  size_t client_count() const;
 
  private:
-  class Connection;
-  TmclTcpServer(EventLoop& loop, TmclHostService& service, int listen_fd, LogSink log);
-  // `after_other_callbacks`: a second look at a full server, once the connections that closed
-  // in the same loop iteration have been removed.
-  void accept_clients(bool after_other_callbacks = false);
-  void close_connection(Connection& connection, const std::string& reason);
+  class Session;
+  TmclTcpServer() = default;
 
-  EventLoop& loop_;
-  TmclHostService& service_;
-  int listen_fd_;
-  LogSink log_;
-  std::map<tmcl::ChannelId, std::shared_ptr<Connection>> connections_;
-  // Deferred work holds a weak reference: it must not touch a server destroyed meanwhile.
-  std::shared_ptr<bool> lifetime_ = std::make_shared<bool>(true);
+  std::unique_ptr<TcpConnectionServer> connections_;
 };
+
+// A non-blocking listening TCP socket (SO_REUSEADDR, backlog 16), or -1 with `error` set to
+// "cannot listen on HOST:PORT: reason".
+int listen_tcp(const TcpEndpointSpec& spec, std::string& error);
 
 // "127.0.0.1:5000" or "[::1]:5000" for an IPv4 or IPv6 socket address.
 std::string format_socket_address(const sockaddr_storage& address);

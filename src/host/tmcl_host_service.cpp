@@ -22,12 +22,31 @@ tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t re
   for (uint32_t attempt = 0; attempt <= UINT16_MAX; ++attempt) {
     const tmcl::ChannelId id = next_channel_id_;
     next_channel_id_ = static_cast<tmcl::ChannelId>(next_channel_id_ == UINT16_MAX ? 1 : next_channel_id_ + 1);
-    if (id == 0 || channels_.count(id) != 0 || queued_requests(id) != 0 || (held_ && held_->channel == id)) continue;
+    if (id == 0 || channels_.count(id) != 0 || event_channels_.count(id) != 0 || queued_requests(id) != 0 ||
+        (held_ && held_->channel == id)) {
+      continue;
+    }
     channels_.emplace(id, Channel{&channel, start_mode(), tmcl::SerialFrameDecoder(resync_gap_us), {}, {}, false});
     return id;
   }
   // 65535 simultaneous connections: the transports limit their clients far below that.
   return 0;
+}
+
+tmcl::ChannelId TmclHostService::open_event_channel(tmcl::ReplySink& sink) {
+  for (uint32_t attempt = 0; attempt <= UINT16_MAX; ++attempt) {
+    const tmcl::ChannelId id = next_channel_id_;
+    next_channel_id_ = static_cast<tmcl::ChannelId>(next_channel_id_ == UINT16_MAX ? 1 : next_channel_id_ + 1);
+    if (id == 0 || channels_.count(id) != 0 || event_channels_.count(id) != 0 || queued_requests(id) != 0) continue;
+    event_channels_.emplace(id, &sink);
+    return id;
+  }
+  return 0;
+}
+
+void TmclHostService::close_event_channel(tmcl::ChannelId id) {
+  event_channels_.erase(id);
+  engine_.forget_channel(id);
 }
 
 void TmclHostService::close_channel(tmcl::ChannelId id) {
@@ -212,6 +231,10 @@ std::vector<uint8_t> TmclHostService::encode_event(LinkMode mode, const tmcl::Re
 }
 
 void TmclHostService::deliver(tmcl::ChannelId channel, const tmcl::Reply& reply) {
+  if (const auto external = event_channels_.find(channel); external != event_channels_.end()) {
+    external->second->deliver(channel, reply);
+    return;
+  }
   const auto found = channels_.find(channel);
   if (found == channels_.end()) return;
   std::vector<uint8_t> bytes = encode_event(found->second.mode, reply);

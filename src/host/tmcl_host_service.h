@@ -65,6 +65,11 @@ class TmclHostService final : public tmcl::ReplySink {
   void close_channel(tmcl::ChannelId id);
   bool is_open(tmcl::ChannelId id) const { return channels_.count(id) != 0; }
 
+  // A channel of a link that frames its own requests (TMCL over CAN, host/tmcl_can_node.h) and
+  // only needs its command 138 replies routed back to `sink`. Never returns 0.
+  tmcl::ChannelId open_event_channel(tmcl::ReplySink& sink);
+  void close_event_channel(tmcl::ChannelId id);
+
   // Bytes a connection received, in arrival order; at most input_room(id) of them. Complete
   // frames and lines become requests; the echo of ASCII mode goes out at once.
   void receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us);
@@ -82,8 +87,13 @@ class TmclHostService final : public tmcl::ReplySink {
   // Serves queued requests in arrival order until the queue is empty or a reply is being held
   // for its telegram pause (the next request waits for it, as on a half-duplex bus).
   void serve_queued();
-  // Sends the command 138 replies that have become due. Call after each tick batch.
-  void deliver_events() { engine_.collect_events(*this); }
+  // Sends the command 138 replies that have become due. Call after each tick batch. Also
+  // notices a power-up that another link caused (255 over CAN), so every link returns to its
+  // start mode.
+  void deliver_events() {
+    follow_power_ups();
+    engine_.collect_events(*this);
+  }
 
   bool reply_held() const { return held_.has_value(); }
   bool reply_held_for(tmcl::ChannelId id) const { return held_ && held_->channel == id; }
@@ -143,6 +153,7 @@ class TmclHostService final : public tmcl::ReplySink {
   tmcl::TmclEngine& engine_;
   EventLoop& loop_;
   std::map<tmcl::ChannelId, Channel> channels_;
+  std::map<tmcl::ChannelId, tmcl::ReplySink*> event_channels_;
   std::map<tmcl::ChannelId, size_t> queued_per_channel_;
   std::deque<QueuedRequest> queue_;
   std::optional<HeldReply> held_;

@@ -43,6 +43,7 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
   module->device_.emplace(*module->nvm_, module->io_);
   if (board::Tmcm1636PowerStage* stage = module->board_->power_stage()) module->device_->axis().attach_power_stage(stage);
   module->device_->engine().power_up();
+  module->can_.emplace(module->device_->engine());
   result.module = std::move(module);
   return result;
 }

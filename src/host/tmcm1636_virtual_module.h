@@ -10,6 +10,7 @@
 #include "core/tmcl/engine.h"
 #include "host/eeprom_file.h"
 #include "host/module_registry.h"
+#include "host/tmcl_can_node.h"
 #include "host/virtual_module.h"
 #include "sim/tmcm1636_sim_board.h"
 #include "sim/tmcm1636_sim_io.h"
@@ -31,6 +32,9 @@ class Tmcm1636VirtualModule final : public VirtualModule {
   std::string_view name() const override { return Device::kName; }
   std::string_view firmware_version() const override { return Device::kIdentity.version_string; }
   tmcl::TmclEngine& engine() override { return device_->engine(); }
+  // TMCL over CAN on GP 71 / GP 70 (core/tmcl/can_link.h).
+  CanBusNode* can_node() override { return &*can_; }
+  TmclCanNode* tmcl_can_node() override { return &*can_; }
   uint32_t tick_period_us() const override { return modules::tmcm1636::kControlTickUs; }
   void run_ticks(uint64_t count) override;
   uint64_t tick_count() const override { return tick_count_; }
@@ -53,6 +57,7 @@ class Tmcm1636VirtualModule final : public VirtualModule {
   board::NonVolatileMemory* nvm_ = nullptr;
   // Constructed once the image is chosen: the device keeps references to it and to io_.
   std::optional<Device> device_;
+  std::optional<TmclCanNode> can_;  // after device_: it refers to the engine
   uint64_t tick_count_ = 0;
 };
 

@@ -33,7 +33,7 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   }
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
-  config.serial_number = 1;
+  config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
   board::CanController& controller = *module;  // private base: reachable here only
   module->device_ = std::make_unique<Device>(*module->nvm_, controller, config);
   // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a

@@ -51,20 +51,11 @@ class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, pri
   Device& device() { return *device_; }
 
  private:
-  // No inputs or outputs yet (the drive issue brings switches, encoders and I/O).
-  class NoSignals final : public sim::SignalBoard {
-   public:
-    std::span<const sim::SignalInfo> input_signals() const override { return {}; }
-    void set_input(std::string_view, double) override {}
-    std::optional<double> read_signal(std::string_view) const override { return std::nullopt; }
-    void take_output_changes(std::vector<sim::OutputChange>&) override {}
-  };
-
   Tmcm3216VirtualModule() = default;
   // board::CanController: what the firmware transmits goes onto the bus.
   bool transmit(const can::CanFrame& frame) override;
 
-  NoSignals signals_;
+  NoSignalBoard signals_;  // no inputs or outputs yet
   std::unique_ptr<EepromFile> eeprom_file_;
   std::unique_ptr<MemoryImage> memory_image_;
   board::NonVolatileMemory* nvm_ = nullptr;

@@ -5,8 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "board/non_volatile_memory.h"
 #include "core/tmcl/engine.h"
@@ -15,6 +18,7 @@
 namespace motwin::host {
 
 class CanBusNode;
+class TmclCanNode;
 
 class VirtualModule {
  public:
@@ -28,6 +32,9 @@ class VirtualModule {
   virtual bool has_tmcl() const { return true; }
   // The module's CAN controller as a node of a virtual bus (host/can_bus.h); nullptr: none.
   virtual CanBusNode* can_node() { return nullptr; }
+  // The same node when it speaks TMCL over CAN (host/tmcl_can_node.h), so that the host runtime
+  // can route its command 138 replies; nullptr otherwise.
+  virtual TmclCanNode* tmcl_can_node() { return nullptr; }
 
   // Fixed simulation step of the module (TMCM-1636: 50 µs).
   virtual uint32_t tick_period_us() const = 0;
@@ -44,6 +51,15 @@ class VirtualModule {
 
   // Inputs to set (--set, scenario files) and outputs to log.
   virtual sim::SignalBoard& signals() = 0;
+};
+
+// The signal board of a module (or group) with no inputs or outputs to offer.
+class NoSignalBoard final : public sim::SignalBoard {
+ public:
+  std::span<const sim::SignalInfo> input_signals() const override { return {}; }
+  void set_input(std::string_view, double) override {}
+  std::optional<double> read_signal(std::string_view) const override { return std::nullopt; }
+  void take_output_changes(std::vector<sim::OutputChange>&) override {}
 };
 
 }  // namespace motwin::host

@@ -1,5 +1,6 @@
 #include "sim/motor_description.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -312,8 +313,18 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
           top.fail("axis_parameters: " + problem);
           break;
         }
+        const bool repeated = std::any_of(m.startup_parameters.begin(), m.startup_parameters.end(),
+                                          [number](const auto& entry) { return entry.first == number; });
+        if (repeated) {  // "5" and "05": which one wins would depend on the spelling
+          top.fail("axis_parameters: parameter " + std::to_string(number) + " is given twice");
+          break;
+        }
         m.startup_parameters.emplace_back(static_cast<uint8_t>(number), static_cast<int32_t>(v));
       }
+      // JSON objects have no order (the parser hands keys over sorted as text: "100" before
+      // "14"): apply in parameter-number order, so that writing and reading a file keeps it.
+      std::stable_sort(m.startup_parameters.begin(), m.startup_parameters.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
     }
   }
   if (top.ok()) top.finish();

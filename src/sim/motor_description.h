@@ -67,7 +67,7 @@ struct MotorDescription {
     bool regenerative = false;         // a lab supply cannot sink current: regeneration charges the bus
   } supply;
 
-  // Axis parameters written into a fresh EEPROM image (number, value), applied in this order.
+  // Axis parameters written into a fresh EEPROM image (number, value), in parameter-number order.
   std::vector<std::pair<uint8_t, int32_t>> startup_parameters;
 
   // Torque per ampere of q current (BLDC: 1.5 p lambda) or of armature current (DC).

@@ -21,7 +21,20 @@ int64_t now_ms() {
       .count();
 }
 
-std::optional<can::CanFrame> parse_frame_element(const std::string& element) {
+// "SEC.USEC" of a socketcand frame element into µs; 0 when malformed.
+uint64_t parse_timestamp_us(std::string_view text) {
+  const size_t dot = text.find('.');
+  const std::string seconds(text.substr(0, dot));
+  std::string fraction = dot == std::string_view::npos ? std::string() : std::string(text.substr(dot + 1));
+  fraction.resize(6, '0');
+  if (seconds.empty() || seconds.find_first_not_of("0123456789") != std::string::npos ||
+      fraction.find_first_not_of("0123456789") != std::string::npos || seconds.size() > 12) {
+    return 0;
+  }
+  return std::stoull(seconds) * 1'000'000u + std::stoull(fraction);
+}
+
+std::optional<ReceivedFrame> parse_frame_element(const std::string& element) {
   const std::vector<std::string_view> words = host::socketcand_words(element);
   if (words.size() < 3 || words[0] != "frame") return std::nullopt;
   can::CanFrame frame;
@@ -35,7 +48,7 @@ std::optional<can::CanFrame> parse_frame_element(const std::string& element) {
       frame.data[i] = static_cast<uint8_t>(std::strtoul(std::string(hex.substr(i * 2u, 2)).c_str(), nullptr, 16));
     }
   }
-  return frame;
+  return ReceivedFrame{frame, parse_timestamp_us(words[2])};
 }
 
 }  // namespace
@@ -121,20 +134,29 @@ std::optional<std::string> SocketcandClient::element(int timeout_ms) {
     if (::poll(&p, 1, static_cast<int>(remaining)) <= 0) continue;
     char chunk[4096];
     const ssize_t n = ::recv(fd_, chunk, sizeof(chunk), 0);
-    if (n <= 0) return std::nullopt;
+    if (n <= 0) {
+      closed_ = true;
+      return std::nullopt;
+    }
     buffer_.append(chunk, static_cast<size_t>(n));
   }
 }
 
-std::optional<can::CanFrame> SocketcandClient::receive(int timeout_ms) {
+std::optional<ReceivedFrame> SocketcandClient::receive_stamped(int timeout_ms) {
   const int64_t deadline = now_ms() + timeout_ms;
   for (;;) {
     const int64_t remaining = deadline - now_ms();
     if (remaining < 0) return std::nullopt;
     const std::optional<std::string> next = element(static_cast<int>(remaining));
     if (!next) return std::nullopt;
-    if (std::optional<can::CanFrame> frame = parse_frame_element(*next)) return frame;
+    if (std::optional<ReceivedFrame> frame = parse_frame_element(*next)) return frame;
   }
+}
+
+std::optional<can::CanFrame> SocketcandClient::receive(int timeout_ms) {
+  const std::optional<ReceivedFrame> received = receive_stamped(timeout_ms);
+  if (!received) return std::nullopt;
+  return received->frame;
 }
 
 namespace {

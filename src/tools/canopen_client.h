@@ -13,6 +13,11 @@
 
 namespace motwin::tools {
 
+struct ReceivedFrame {
+  can::CanFrame frame;
+  uint64_t timestamp_us = 0;  // the server's stamp (Motwin: simulated time)
+};
+
 class SocketcandClient {
  public:
   struct OpenResult {
@@ -29,6 +34,9 @@ class SocketcandClient {
   bool send(const can::CanFrame& frame);
   // The next frame from the bus, or nullopt after `timeout_ms`.
   std::optional<can::CanFrame> receive(int timeout_ms);
+  std::optional<ReceivedFrame> receive_stamped(int timeout_ms);
+  // false once the server closed the connection.
+  bool connected() const { return !closed_; }
 
  private:
   explicit SocketcandClient(int fd) : fd_(fd) {}
@@ -37,6 +45,7 @@ class SocketcandClient {
 
   int fd_;
   std::string buffer_;
+  bool closed_ = false;
 };
 
 struct SdoResult {

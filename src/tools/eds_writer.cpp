@@ -124,7 +124,7 @@ std::string write_eds(canopen::TableDictionary<Owner>& dictionary, std::string_v
   line("GroupMessaging=0");
   line(fmt::format("NrOfRXPDO={}", rpdos));
   line(fmt::format("NrOfTXPDO={}", tpdos));
-  line("LSS_Supported=0");  // the manual lists LSS; Motwin does not implement it yet
+  line("LSS_Supported=1");  // CiA-305 slave (core/canopen/lss_slave.h)
   line("");
   line("[DummyUsage]");
   for (int i = 1; i <= 7; ++i) line(fmt::format("Dummy000{}={}", i, i >= 2 ? 1 : 0));

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "core/modules/tmcm142/tmcm142.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/params/parameter.h"
 #include "core/params/parameter_table.h"
@@ -59,8 +60,19 @@ ModuleParameterListing tmcm1636_listing() {
   return listing;
 }
 
+// Descriptions tagged params::kMotwinDecisionTag mark the parameters Motwin numbered itself.
+ModuleParameterListing tmcm142_listing() {
+  using modules::tmcm142::Tmcm142;
+  ModuleParameterListing listing{std::string(Tmcm142::kName), {}};
+  listing.sections.push_back(section_from_table("Axis parameters", ParameterKind::kAxis, std::nullopt, Tmcm142::axis_parameters()));
+  listing.sections.push_back(section_from_table("Global parameters", ParameterKind::kGlobal, uint8_t{0}, Tmcm142::global_parameters()));
+  listing.sections.push_back(user_variable_section(tmcl::kUserVariableCount, modules::tmcm142::kStorableUserVariables));
+  return listing;
+}
+
 constexpr ParameterListingSource kSources[] = {
     {modules::tmcm1636::Tmcm1636::kName, &tmcm1636_listing},
+    {modules::tmcm142::Tmcm142::kName, &tmcm142_listing},
 };
 
 // --- Text forms --------------------------------------------------------------------------------

@@ -20,6 +20,15 @@ LOAD = 0x64616F6C
 SDO_TIMEOUT = 1.0
 
 
+def crc16_ccitt(data, crc=0):
+    """CRC of SDO block transfer: polynomial 0x1021, initial value 0, no reflection."""
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+    return crc
+
+
 class CanServer(mh.Server):
     """`motwin serve` running a TMCM-3216 on a socketcand endpoint on a free port."""
 
@@ -178,6 +187,99 @@ class CanopenClient:
         data = self._check_abort(
             self._request(node, [header, index & 0xFF, index >> 8, sub] + list(payload.ljust(4, b"\0"))), index, sub)
         check_equal(data[0], 0x60, "initiate download response")
+
+    # SDO block transfer (CiA-301 7.2.4.3.9+) -----------------------------------------------------
+    def block_upload(self, node, index, sub, blksize=127, crc=True, pst=0):
+        """Block upload with raw frames; returns the bytes. Checks sequence numbers and the CRC."""
+        mux = [index & 0xFF, index >> 8, sub]
+        data = self._check_abort(self._request(node, [0xA0 | (4 if crc else 0)] + mux + [blksize, pst, 0, 0]),
+                                 index, sub)
+        check_equal(data[0] & 0xE3, 0xC2, "block upload initiate response (size indicated)")
+        server_crc = bool(data[0] & 0x04)
+        size = struct.unpack_from("<I", data, 4)[0]
+        self.send(0x600 + node, [0xA3, 0, 0, 0, 0, 0, 0, 0])
+        value = b""
+        while True:
+            last = False
+            seqno = 0
+            while not last and seqno < blksize:
+                seg = self.receive(lambda m: m.arbitration_id == 0x580 + node, SDO_TIMEOUT, "upload segment")
+                seg = bytes(seg.data)
+                check_equal(seg[0] & 0x7F, seqno + 1, "upload segment sequence number")
+                seqno += 1
+                value += seg[1:8]
+                last = bool(seg[0] & 0x80)
+            self.send(0x600 + node, [0xA2, seqno, blksize, 0, 0, 0, 0, 0])
+            if last:
+                break
+        end = self._check_abort(
+            self.receive(lambda m: m.arbitration_id == 0x580 + node, SDO_TIMEOUT, "block upload end"), index, sub)
+        check_equal(end[0] & 0xE3, 0xC1, "block upload end request")
+        value = value[:len(value) - ((end[0] >> 2) & 7)]
+        check_equal(len(value), size, "block upload size")
+        if crc and server_crc:
+            check_equal(struct.unpack_from("<H", end, 1)[0], crc16_ccitt(value), "block upload CRC")
+        self.send(0x600 + node, [0xA1, 0, 0, 0, 0, 0, 0, 0])
+        return value
+
+    def block_download(self, node, index, sub, value, crc=True, crc_value=None):
+        """Block download with raw frames, in the sub-blocks the server asks for."""
+        mux = [index & 0xFF, index >> 8, sub]
+        data = self._check_abort(
+            self._request(node, [0xC2 | (4 if crc else 0)] + mux + list(struct.pack("<I", len(value)))), index, sub)
+        check_equal(data[0] & 0xE3, 0xA0, "block download initiate response")
+        blksize = data[4]
+        check(1 <= blksize <= 127, f"server block size {blksize}")
+        segments = [value[i:i + 7] for i in range(0, len(value), 7)] or [b""]
+        position = 0
+        while position < len(segments):
+            block = segments[position:position + blksize]
+            for n, segment in enumerate(block, start=1):
+                last = position + n == len(segments)
+                self.send(0x600 + node, [(0x80 if last else 0) | n] + list(segment.ljust(7, b"\0")))
+            ack = self._check_abort(
+                self.receive(lambda m: m.arbitration_id == 0x580 + node, SDO_TIMEOUT, "sub-block ack"), index, sub)
+            check_equal(ack[0], 0xA2, "block download sub-block response")
+            position += ack[1]
+            blksize = ack[2]
+        unused = 7 - len(segments[-1]) if value else 7
+        crc_field = crc16_ccitt(value) if crc_value is None else crc_value
+        end = self._check_abort(self._request(node, [0xC1 | (unused << 2)] + list(struct.pack("<H", crc_field)) +
+                                              [0, 0, 0, 0, 0]), index, sub)
+        check_equal(end[0], 0xA1, "block download end response")
+
+    # PDO / SYNC / LSS -------------------------------------------------------------------------------
+    def configure_pdo(self, node, comm_index, cob_id, transmission_type, entries, inhibit_100us=0, event_ms=0):
+        """python-canopen's PdoMap.save() order: COB-ID with bit 31, type, (TPDO) inhibit, event timer,
+        SYNC start value (may abort), mapping count 0, entries, count, COB-ID without bit 31."""
+        transmit = comm_index >= 0x1800
+        self.download(node, comm_index, 1, cob_id | 0x80000000, 4)
+        self.download(node, comm_index, 2, transmission_type, 1)
+        if transmit:
+            self.download(node, comm_index, 3, inhibit_100us, 2)
+            self.download(node, comm_index, 5, event_ms, 2)
+            try:
+                self.download(node, comm_index, 6, 0, 1)
+            except SdoAborted:
+                pass  # python-canopen ignores a missing SYNC start value
+        map_index = comm_index + 0x200
+        self.download(node, map_index, 0, 0, 1)
+        for sub, entry in enumerate(entries, start=1):
+            self.download(node, map_index, sub, entry, 4)
+        self.download(node, map_index, 0, len(entries), 1)
+        self.download(node, comm_index, 1, cob_id, 4)
+
+    def lss(self, data, answer=True, timeout=1.0):
+        """One LSS master frame (0x7E5, padded to 8 bytes); the slave's answer (0x7E4) or None."""
+        self.send(0x7E5, list(data) + [0] * (8 - len(data)))
+        if not answer:
+            return None
+        return bytes(self.receive(lambda m: m.arbitration_id == 0x7E4, timeout, f"LSS answer to {data[0]:#04x}").data)
+
+    def lss_silent(self, data, wait=0.2):
+        """Sends an LSS frame that must not be answered; returns the answers seen (should be [])."""
+        self.send(0x7E5, list(data) + [0] * (8 - len(data)))
+        return self.collect(wait, lambda m: m.arbitration_id == 0x7E4)
 
     def abort_code(self, operation, *args):
         try:

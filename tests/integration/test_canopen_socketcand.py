@@ -83,10 +83,10 @@ def test_abort_codes(motwin):
         check_equal(bus.abort_code(bus.download, NODE, 0x1017, 0, 1, 1), 0x06070013, "1017 with 1 byte")
         check_equal(bus.abort_code(bus.download, NODE, 0x1029, 1, 7, 1), 0x06090031, "1029 sub 1 too high")
         check_equal(bus.abort_code(bus.download, NODE, 0x1010, 1, 0x12345678, 4), 0x08000020, "bad signature")
-        # Block upload request: aborted with 05040001 (no block transfer yet).
-        bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 0x7F, 0, 0, 0])
+        # Block upload request with block size 0: aborted with 05040002 (test_canopen_block.py does the rest).
+        bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 0x00, 0, 0, 0])
         msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block upload answer")
-        check_equal(bytes(msg.data), bytes([0x80, 0x08, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05]), "block upload abort")
+        check_equal(bytes(msg.data), bytes([0x80, 0x08, 0x10, 0x00, 0x02, 0x00, 0x04, 0x05]), "block upload abort")
         # Still serving.
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 after the aborts")
         server.stop()
@@ -226,6 +226,9 @@ def test_heartbeat_consumer_emcy(motwin):
         bus.nmt(NMT_PREOP, NODE)  # ...and goes out in pre-operational
         emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 1.0, "EMCY 0000 in pre-operational")
         check_equal(bytes(emcy.data), bytes([0, 0, 0, 0, 0xFF, 0, 0, 0]), "EMCY 0000")
+        # Another heartbeat first: the 200 ms since the last one may have run out again by now
+        # (slow builds), which would set 1001 once more.
+        bus.send(0x710, [0x05])
         check_equal(bus.upload_u(NODE, 0x1001, 0), 0x00, "1001 after the heartbeat came back")
         server.stop()
 
@@ -270,7 +273,7 @@ def test_bus_capture_pcap_and_candump(motwin):
 
 def test_serve_argument_errors(motwin):
     cases = [
-        (["--can", "slcan:/tmp/x"], "--can: expected socketcand"),
+        (["--can", "kvaser:0"], "--can: expected socketcand"),
         (["--can", "socketcand:127.0.0.1:0", "--tmcl-tcp", "127.0.0.1:0"], "has no TMCL interface"),
         (["--can", "socketcand:127.0.0.1:0", "--node-id", "128"], "--node-id"),
     ]
@@ -285,15 +288,6 @@ def test_serve_argument_errors(motwin):
                       f"stderr for {extra}: {lines!r}")
             finally:
                 server.cleanup()
-        # A TMCL module has no CAN interface yet.
-        server = CanServer(MOTWIN, "none")
-        server.args = [MOTWIN, "serve", "--module", "tmcm-1636", "--state-dir", "none",
-                       "--can", "socketcand:127.0.0.1:0"]
-        try:
-            check_equal(server.start_expect_failure(), 2, "exit status for tmcm-1636 --can")
-            check("has no CAN interface" in server.stderr_text(), f"stderr: {server.stderr_text()!r}")
-        finally:
-            server.cleanup()
         del tmp
 
 

@@ -169,7 +169,8 @@ TEST(SdoServer, values_out_of_range_abort_06090030_31_32) {
   EXPECT_EQ(rig.download(0x1800, 2, 0, 1), 0x06090030u);     // transmission type 0 not supported
   EXPECT_EQ(rig.download(0x1800, 2, 241, 1), 0x06090030u);
   EXPECT_EQ(rig.download(0x1800, 2, 240, 1), 0u);
-  EXPECT_EQ(rig.download(0x1005, 0, 0x40000080), 0x06090030u);  // SYNC producer: not this module
+  EXPECT_EQ(rig.download(0x1005, 0, 0x40000080), 0u);           // SYNC producer: Motwin extension
+  EXPECT_EQ(rig.download(0x1005, 0, 0x80000080), 0x06090030u);  // bit 31 is not a 1005 bit
   EXPECT_EQ(rig.download(0x1005, 0, 0x20000080), 0x06090030u);  // 29-bit
 }
 
@@ -188,16 +189,10 @@ TEST(SdoServer, pdo_mapping_changes_while_valid_abort_08000022) {
   EXPECT_EQ(rig.download(0x1600, 1, 0, 4), 0x08000022u);
 }
 
-TEST(SdoServer, block_transfer_requests_abort_05040001) {
+TEST(SdoServer, command_specifier_7_aborts_05040001) {
   Tmcm3216Rig rig;
-  // Block upload initiate (ccs 5) of 1008, as python-canopen and CANopenNode clients may try.
-  const can::CanFrame upload = rig.sdo({0xA4, 0x08, 0x10, 0x00, 127, 0, 0, 0});
-  EXPECT_EQ(Tmcm3216Rig::abort_of(upload), 0x05040001u);
-  EXPECT_EQ(upload.data[1], 0x08);
-  EXPECT_EQ(upload.data[2], 0x10);
-  const can::CanFrame download = rig.sdo({0xC6, 0x17, 0x10, 0x00, 2, 0, 0, 0});  // ccs 6
-  EXPECT_EQ(Tmcm3216Rig::abort_of(download), 0x05040001u);
-  EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({0xE0, 0, 0, 0, 0, 0, 0, 0})), 0x05040001u);  // ccs 7
+  EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({0xE0, 0, 0, 0, 0, 0, 0, 0})), 0x05040001u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);  // still serving
 }
 
 TEST(SdoServer, segments_out_of_sequence_abort_05040001) {

@@ -146,7 +146,17 @@ TEST(Socketcand, can_endpoint_specs) {
   spec = parse_can_endpoint("socketcand:4000", error);
   ASSERT_TRUE(spec);
   EXPECT_EQ(spec->tcp.port, 4000);
-  EXPECT_FALSE(parse_can_endpoint("slcan:/tmp/x", error));
+  spec = parse_can_endpoint("slcan:/tmp/x", error);
+  ASSERT_TRUE(spec) << error;
+  EXPECT_EQ(spec->transport, CanTransport::kSlcanPty);
+  EXPECT_EQ(spec->device, "/tmp/x");
+  spec = parse_can_endpoint("socketcan:vcan0", error);
+  ASSERT_TRUE(spec) << error;
+  EXPECT_EQ(spec->transport, CanTransport::kSocketcan);
+  EXPECT_EQ(spec->device, "vcan0");
+  EXPECT_FALSE(parse_can_endpoint("slcan", error));
+  EXPECT_FALSE(parse_can_endpoint("socketcan:", error));
+  EXPECT_FALSE(parse_can_endpoint("kvaser:0", error));
   EXPECT_FALSE(parse_can_endpoint("socketcand:1.2.3.4:99999", error));
 }
 

@@ -185,6 +185,22 @@ TEST(MotorDescription, a_user_file_with_kv_and_comments) {
   EXPECT_EQ(parsed.motor->startup_parameters.size(), 2u);
 }
 
+// Found by fuzz/motor_description.cpp: JSON keys come sorted as text ("100" before "14"), and
+// "05" is parameter 5 too. Start-up parameters apply in number order; a number given twice is an error.
+TEST(MotorDescription, axis_parameters_in_number_order_and_each_number_once) {
+  const MotorLoadResult parsed = parse_motor_description(
+      R"({"flux_linkage_wb": 0.005, "axis_parameters": {"100": 8192, "25": 1, "14": 3, "05": 7}})", "p.json");
+  ASSERT_TRUE(parsed.motor) << parsed.error;
+  const std::vector<std::pair<uint8_t, int32_t>> expected{{5, 7}, {14, 3}, {25, 1}, {100, 8192}};
+  EXPECT_EQ(parsed.motor->startup_parameters, expected);
+  const MotorLoadResult again = parse_motor_description(motor_description_json(*parsed.motor), "q.json");
+  ASSERT_TRUE(again.motor) << again.error;
+  EXPECT_EQ(again.motor->startup_parameters, expected);
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"5": 1, "05": 2}})", "r.json")
+                .error,
+            "r.json: axis_parameters: parameter 5 is given twice");
+}
+
 TEST(MotorDescription, errors_name_the_file_and_the_problem) {
   EXPECT_EQ(parse_motor_description("{", "a.json").error, "a.json: not valid JSON");
   EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 4, "flux_linkage_wb": 0.005, "resistanse_ohm": 1})", "b.json").error,

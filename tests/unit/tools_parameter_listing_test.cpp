@@ -84,7 +84,7 @@ TEST(ParameterListing, module_names_and_formats_are_looked_up_case_insensitively
   EXPECT_EQ(parse_listing_format("CSV"), ListingFormat::kCsv);
   EXPECT_EQ(parse_listing_format("markdown"), ListingFormat::kMarkdown);
   EXPECT_FALSE(parse_listing_format("json"));
-  EXPECT_EQ(known_module_names(), "tmcm-1636");
+  EXPECT_EQ(known_module_names(), "tmcm-1636, tmcm-142");
 }
 
 }  // namespace

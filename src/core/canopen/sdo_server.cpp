@@ -9,9 +9,9 @@ constexpr uint8_t kCcsInitiateDownload = 1;
 constexpr uint8_t kCcsInitiateUpload = 2;
 constexpr uint8_t kCcsUploadSegment = 3;
 constexpr uint8_t kCcsAbort = 4;
+constexpr uint8_t kCcsBlockUpload = 5;
+constexpr uint8_t kCcsBlockDownload = 6;
 constexpr uint8_t kToggleBit = 0x10;
-
-uint16_t multiplexer_index(const uint8_t* data) { return static_cast<uint16_t>(data[1] | data[2] << 8); }
 
 }  // namespace
 
@@ -30,6 +30,8 @@ void SdoServer::reset() {
   idle_us_ = 0;
 }
 
+uint16_t SdoServer::multiplexer_index(const uint8_t* data) { return static_cast<uint16_t>(data[1] | data[2] << 8); }
+
 void SdoServer::process(uint32_t elapsed_us) {
   if (request_pending_) {
     request_pending_ = false;
@@ -46,8 +48,11 @@ void SdoServer::handle(const can::CanFrame& request) {
   if (request.rtr) return;  // RTR is not supported (manual 1.1); nothing to answer
   uint8_t data[8] = {};
   for (uint8_t i = 0; i < request.dlc && i < 8; ++i) data[i] = request.data[i];
+  // Inside a block download sub-block every frame is a segment (seqno | last bit); only 0x80
+  // (sequence number 0) cannot be one and is the client's abort.
+  const bool block_segment = state_ == SdoState::kDownloadBlock && data[0] != 0x80;
   const uint8_t ccs = data[0] >> 5;
-  if (ccs == kCcsAbort) {  // the client gives up: no answer
+  if (!block_segment && ccs == kCcsAbort) {  // the client gives up: no answer
     state_ = SdoState::kIdle;
     return;
   }
@@ -57,6 +62,11 @@ void SdoServer::handle(const can::CanFrame& request) {
     abort(in_transfer ? index_ : 0, in_transfer ? sub_ : 0, SdoAbort::kUnknownCommand);
     return;
   }
+  if (block_segment) {
+    download_block_segment(data);
+    return;
+  }
+  const uint8_t subcommand = data[0] & 0x03;  // block transfer: cs / ss
   switch (ccs) {
     case kCcsInitiateDownload: initiate_download(data); return;  // also ends a stale transfer
     case kCcsInitiateUpload: initiate_upload(data); return;
@@ -72,11 +82,31 @@ void SdoServer::handle(const can::CanFrame& request) {
         return;
       }
       break;
-    default: break;  // 5 block upload, 6 block download, 7: not supported
+    case kCcsBlockDownload:
+      if ((data[0] & 0x01) == 0) {
+        initiate_block_download(data);
+        return;
+      }
+      if (state_ == SdoState::kDownloadBlockEnd) {
+        end_block_download(data);
+        return;
+      }
+      break;
+    case kCcsBlockUpload:
+      if (subcommand == 0) {
+        initiate_block_upload(data);
+        return;
+      }
+      if (state_ == SdoState::kUploadBlockStart || state_ == SdoState::kUploadBlockAck ||
+          state_ == SdoState::kUploadBlockEnd) {
+        upload_block_request(data);
+        return;
+      }
+      break;
+    default: break;  // 7: not defined
   }
   if (state_ == SdoState::kIdle) {
-    const bool has_multiplexer = ccs == 5 || ccs == 6;
-    abort(has_multiplexer ? multiplexer_index(data) : 0, has_multiplexer ? data[3] : 0, SdoAbort::kUnknownCommand);
+    abort(0, 0, SdoAbort::kUnknownCommand);
   } else {
     abort(index_, sub_, SdoAbort::kUnknownCommand);
   }

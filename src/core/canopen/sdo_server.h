@@ -1,19 +1,26 @@
-// SDO server (CiA-301 7.2.4): expedited and segmented transfer in both directions, in the shape
-// of CANopenNode's CO_SDOserver: a request is queued by on_request() and answered by the next
-// process() call, which is also told how much time passed (the transfer timeout). Block
-// transfer is not implemented yet: its requests are aborted with 05040001, which python-canopen
-// and CANopenNode clients take as "fall back to segmented" (notes/canopen.md).
+// SDO server (CiA-301 7.2.4): expedited, segmented and block transfer in both directions, in the
+// shape of CANopenNode's CO_SDOserver: a request is queued by on_request() and answered by the
+// next process() call, which is also told how much time passed (the transfer timeout). The block
+// transfer half lives in sdo_block.cpp.
 //
 // States (explicit, as CO_SDO_ST_*):
-//   kIdle              waiting for an initiate request
-//   kDownloadSegments  segmented download: waiting for the next download segment
-//   kUploadSegments    segmented upload: waiting for the next upload segment request
+//   kIdle               waiting for an initiate request
+//   kDownloadSegments   segmented download: waiting for the next download segment
+//   kUploadSegments     segmented upload: waiting for the next upload segment request
+//   kDownloadBlock      block download: receiving the segments of a sub-block
+//   kDownloadBlockEnd   block download: all data received, waiting for the end request (CRC)
+//   kUploadBlockStart   block upload: initiate answered, waiting for the start request (A3)
+//   kUploadBlockAck     block upload: a sub-block sent, waiting for its acknowledgement (A2)
+//   kUploadBlockEnd     block upload: end sent, waiting for the client's end response (A1)
 // Every error answers with an abort frame and returns to kIdle:
-//   request in kIdle that is not an initiate (segment, unknown ccs, block) 05040001
+//   request in kIdle that is not an initiate (segment, ccs 7)           05040001
 //   segment with the wrong toggle bit                                   05030000
-//   no request for kTimeoutUs in a segment state                        05040000
+//   no request for kTimeoutUs in any transfer state                     05040000
+//   block size 0 or above 127 (upload initiate, upload acknowledgement) 05040002
+//   sequence number 0 or above the block size; ackseq above the sent   05040003
+//   CRC of a block download different from the data                     05040004
 //   object / sub-index missing, access, size, range, state              from the dictionary
-//   segmented download whose bytes differ from the size it announced   06070010
+//   segmented or block download whose bytes differ from the announced   06070010
 #pragma once
 
 #include <cstddef>
@@ -28,14 +35,29 @@ namespace motwin::canopen {
 inline constexpr uint32_t kSdoRequestCobIdBase = 0x600;   // client -> server
 inline constexpr uint32_t kSdoResponseCobIdBase = 0x580;  // server -> client
 
-enum class SdoState : uint8_t { kIdle, kDownloadSegments, kUploadSegments };
+enum class SdoState : uint8_t {
+  kIdle,
+  kDownloadSegments,
+  kUploadSegments,
+  kDownloadBlock,
+  kDownloadBlockEnd,
+  kUploadBlockStart,
+  kUploadBlockAck,
+  kUploadBlockEnd,
+};
+
+// CRC-16 of CiA-301 block transfer: CCITT polynomial 0x1021, initial value 0, no reflection.
+uint16_t crc16_ccitt(const uint8_t* data, size_t length, uint16_t crc = 0);
 
 class SdoServer {
  public:
   // CANopenNode's default server timeout; python-canopen's client waits 0.3 s per response.
   static constexpr uint32_t kTimeoutUs = 1'000'000;
-  // Largest value a segmented transfer carries (the longest object is a visible string).
-  static constexpr size_t kBufferSize = 64;
+  // Largest value a segmented or block transfer carries. The TMCM-3216's longest object is a
+  // short visible string; the room is for larger (test) objects and whole block transfers.
+  static constexpr size_t kBufferSize = 1024;
+  // Segments per sub-block the server asks for in a block download (CiA-301 maximum).
+  static constexpr uint8_t kMaxBlockSize = 127;
 
   SdoServer(ObjectDictionary& dictionary, board::CanController& can) : dictionary_(dictionary), can_(can) {}
 
@@ -54,11 +76,19 @@ class SdoServer {
   uint64_t dropped_requests() const { return dropped_requests_; }
 
  private:
+  static uint16_t multiplexer_index(const uint8_t* data);
   void handle(const can::CanFrame& request);
   void initiate_download(const uint8_t* data);
   void download_segment(const uint8_t* data);
   void initiate_upload(const uint8_t* data);
   void upload_segment(const uint8_t* data);
+  // Block transfer (sdo_block.cpp). `data` is the request (8 bytes).
+  void initiate_block_download(const uint8_t* data);
+  void download_block_segment(const uint8_t* data);
+  void end_block_download(const uint8_t* data);
+  void initiate_block_upload(const uint8_t* data);
+  void upload_block_request(const uint8_t* data);
+  void send_upload_sub_block();
   void abort(uint16_t index, uint8_t sub, SdoAbort code);
   void respond(const uint8_t (&data)[8]);
 
@@ -81,6 +111,11 @@ class SdoServer {
   size_t size_ = 0;          // announced (download) or total (upload) size
   size_t offset_ = 0;        // bytes received or sent so far
   uint8_t buffer_[kBufferSize] = {};
+  // Block transfer: whether both sides use the CRC, segments per sub-block, the last sequence
+  // number received in order (download) or sent (upload).
+  bool block_crc_ = false;
+  uint8_t block_size_ = 0;
+  uint8_t block_sequence_ = 0;
 };
 
 }  // namespace motwin::canopen

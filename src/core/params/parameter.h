@@ -75,6 +75,11 @@ enum class Unit : uint8_t {
   kBaudRateCode,
   kBitRateCode,
   kAddress,
+  kMicrosteps,        // stepper position (TMCM-142)
+  kSpeed,             // stepper velocity: TMC457 units or µsteps/s, per AP 255 (TMCM-142)
+  kAcceleration,      // stepper acceleration: TMC457 units or µsteps/s² (TMCM-142)
+  kTmc457Velocity,    // TMC457 velocity units whatever AP 255 says (TMCM-142)
+  kTenMilliseconds,
 };
 
 constexpr std::string_view unit_symbol(Unit unit) {
@@ -95,9 +100,19 @@ constexpr std::string_view unit_symbol(Unit unit) {
     case Unit::kBaudRateCode: return "code";
     case Unit::kBitRateCode: return "code";
     case Unit::kAddress: return "address";
+    case Unit::kMicrosteps: return "usteps";
+    case Unit::kSpeed: return "v (AP 255)";
+    case Unit::kAcceleration: return "a (AP 255)";
+    case Unit::kTmc457Velocity: return "v457";
+    case Unit::kTenMilliseconds: return "10ms";
   }
   return "";
 }
+
+// Descriptions of parameters whose number or meaning no public source gives start with this tag
+// (`motwin params` and the module docs show it; TMCM-142, notes/tmcm142.md).
+inline constexpr std::string_view kMotwinDecisionTag = "[Motwin decision] ";
+constexpr bool is_motwin_decision(std::string_view description) { return description.starts_with(kMotwinDecisionTag); }
 
 // What the manual says about one parameter. Pure data.
 struct ParameterInfo {

@@ -75,6 +75,24 @@ class TmclDevice {
   virtual bool stop_switch_active(uint8_t /*motor*/, bool /*left*/) const { return false; }
   virtual bool reference_search_running(uint8_t /*motor*/) const { return false; }
 
+  // RFS (13): type 0 START, 1 STOP, 2 STATUS (value 0 when done, non-zero while running).
+  // Modules without a reference search answer status 2 (invalid command).
+  virtual Status reference_search(uint8_t /*motor*/, uint8_t /*type*/, int32_t& /*value*/) {
+    return Status::kInvalidCommand;
+  }
+
+  // Coordinates (TMCM-142 generation, notes/tmcl.md): SCO 30, GCO 31, CCO 32, ACO 39 (ACO is
+  // set_coordinate with the accumulator). motor 255 selects the special forms `SCO n, 255, 0`
+  // (RAM to EEPROM) and `GCO n, 255, 0` (EEPROM to RAM). Modules without coordinates answer
+  // status 2 (invalid command).
+  virtual Status set_coordinate(uint8_t /*number*/, uint8_t /*motor*/, int32_t /*position*/) {
+    return Status::kInvalidCommand;
+  }
+  virtual Status get_coordinate(uint8_t /*number*/, uint8_t /*motor*/, int32_t& /*position*/) {
+    return Status::kInvalidCommand;
+  }
+  virtual Status capture_coordinate(uint8_t /*number*/, uint8_t /*motor*/) { return Status::kInvalidCommand; }
+
  protected:
   ~TmclDevice() = default;
 };

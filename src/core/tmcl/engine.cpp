@@ -221,6 +221,26 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       const Status status = device_.get_input(in.type, in.motor_bank, value);
       return read_result(status, value, echo);
     }
+    // RFS and coordinates: the motor byte is the device's to check, so that a module without
+    // them answers status 2 whatever the operands (255 selects the coordinates' EEPROM copies).
+    case command::kRfs: {
+      int32_t value = 0;
+      const Status status = device_.reference_search(in.motor_bank, in.type, value);
+      // STATUS is a read (a program loads the accumulator); START and STOP echo the operand.
+      if (in.type == 2) return read_result(status, value, echo);
+      return status_only(status, echo);
+    }
+    case command::kSco:
+      return status_only(device_.set_coordinate(in.type, in.motor_bank, in.value), echo);
+    case command::kAco:
+      return status_only(device_.set_coordinate(in.type, in.motor_bank, device_.runtime().accumulator), echo);
+    case command::kGco: {
+      int32_t value = 0;
+      const Status status = device_.get_coordinate(in.type, in.motor_bank, value);
+      return read_result(status, value, echo);
+    }
+    case command::kCco:
+      return status_only(device_.capture_coordinate(in.type, in.motor_bank), echo);
     case command::kNop:
       return status_only(Status::kOk, echo);
     case command::kCalc:

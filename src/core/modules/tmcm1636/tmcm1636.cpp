@@ -1,101 +1,29 @@
 #include "core/modules/tmcm1636/tmcm1636.h"
 
-#include <cstring>
-
 #include "core/tmcl/instruction.h"
 
 namespace motwin::modules::tmcm1636 {
 namespace {
 
-using params::Access;
-using params::has;
 using tmcl::Status;
 
-constexpr uint8_t kBankGlobal = 0;
-constexpr uint8_t kBankUserVariables = 2;
 // GIO/SIO banks (manual 2.6.13/2.6.14).
 constexpr uint8_t kIoBankDigitalInputs = 0;
 constexpr uint8_t kIoBankAnalogInputs = 1;
 constexpr uint8_t kIoBankDigitalOutputs = 2;
 
-constexpr Access kStoredMask = Access::kEeprom | Access::kAutoStore;
-
-bool is_stored(const params::ParameterInfo& info) { return has(info.access, kStoredMask); }
-
 }  // namespace
 
-Tmcm1636::Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io) : nvm_(nvm), io_(io) {}
+Tmcm1636::Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io) : ModuleStorage(nvm), io_(io) {}
 
-void Tmcm1636::format_factory_image(uint8_t* image, size_t size) {
-  std::memset(image, 0, size);
-  if (size < kNvmLayout.total_size) return;
-  for (const auto& row : axis_parameters().rows()) {
-    if (is_stored(row.info)) {
-      tmcl::put_le32(image + kNvmLayout.axis_parameter(0, static_cast<uint8_t>(row.info.number)),
-                     static_cast<int32_t>(row.info.default_value));
-    }
-  }
-  for (const auto& row : global_parameters().rows()) {
-    if (is_stored(row.info)) {
-      tmcl::put_le32(image + kNvmLayout.global_parameter(static_cast<uint8_t>(row.info.number)),
-                     static_cast<int32_t>(row.info.default_value));
-    }
-  }
-  // An empty program memory holds STOP everywhere, so autostart (GP 77 = 1 by default) of a
-  // module without a program stops at once.
-  for (uint32_t address = 0; address < kNvmLayout.program_capacity; ++address) {
-    tmcl::encode_program_record(tmcl::Instruction{tmcl::command::kStop, 0, 0, 0},
-                                image + kNvmLayout.program_offset + address * tmcl::kProgramRecordBytes);
-  }
-}
-
-bool Tmcm1636::store_value(uint32_t offset, int32_t value) {
-  uint8_t bytes[4];
-  tmcl::put_le32(bytes, value);
-  last_store_failed_ = !nvm_.write(offset, bytes, sizeof bytes);
-  return !last_store_failed_;
-}
-
-int32_t Tmcm1636::stored_value(uint32_t offset) const {
-  if (nvm_.size() < offset + 4) return 0;
-  return tmcl::get_le32(nvm_.data() + offset);
-}
-
-// Power-up (and command 255): RAM state cleared, every stored parameter restored from the
-// EEPROM image. A stored value outside its row's range (an image from elsewhere) is skipped
-// and the default kept, so a bad image can never put the module into an invalid state.
-void Tmcm1636::power_up() {
+// Power-up: the live state and every setting back to the defaults, before the restore.
+void Tmcm1636::clear_ram_state() {
   axis_.reset_state();
   axis_.config = AxisConfig{};
   global_ = GlobalConfig{};
-  user_variables_.fill(0);
   runtime_ = tmcl::TmclRuntime{};
   tick_timer_ms_ = 0;
   tick_fraction_ = 0;
-  if (nvm_.size() < kNvmLayout.total_size) return;
-  for (const auto& row : axis_parameters().rows()) {
-    if (!is_stored(row.info)) continue;
-    const int32_t value = stored_value(kNvmLayout.axis_parameter(0, static_cast<uint8_t>(row.info.number)));
-    if (params::in_range(row.info, value)) row.binding.set(*this, 0, value);
-  }
-  axis_.finish_restore();  // later writes are host commands (AP 15 starts encoder initialisation)
-  for (const auto& row : global_parameters().rows()) {
-    if (!is_stored(row.info)) continue;
-    const int32_t value = stored_value(kNvmLayout.global_parameter(static_cast<uint8_t>(row.info.number)));
-    if (params::in_range(row.info, value)) row.binding.set(*this, kBankGlobal, value);
-  }
-  if (global_.skip_user_variable_restore != 0) return;
-  for (uint8_t i = 0; i < kStorableUserVariables; ++i) {
-    user_variables_[i] = stored_value(kNvmLayout.user_variable(i));
-  }
-}
-
-// Command 137: the parameter part of the image back to factory values; a stored TMCL program
-// is kept (docs/decisions.md). The engine powers the module up afterwards.
-void Tmcm1636::restore_factory_defaults() {
-  static uint8_t image[kNvmLayout.total_size];
-  format_factory_image(image, sizeof image);
-  last_store_failed_ = !nvm_.write(0, image, kNvmLayout.program_offset);
 }
 
 void Tmcm1636::tick() {
@@ -147,84 +75,6 @@ Status Tmcm1636::move(uint8_t motor, uint8_t move_type, int32_t value) {
 }
 
 bool Tmcm1636::position_reached(uint8_t /*motor*/) const { return axis_.position_reached(); }
-
-Status Tmcm1636::set_axis_parameter(uint8_t number, uint8_t motor, int32_t value) {
-  return axis_parameters().write(*this, motor, number, value);
-}
-
-Status Tmcm1636::get_axis_parameter(uint8_t number, uint8_t motor, int32_t& value) {
-  return axis_parameters().read(*this, motor, number, value);
-}
-
-Status Tmcm1636::store_axis_parameter(uint8_t number, uint8_t motor) {
-  const auto* row = axis_parameters().find(number);
-  if (row == nullptr || !has(row->info.access, Access::kEeprom)) return Status::kWrongType;
-  return store_value(kNvmLayout.axis_parameter(motor, number), row->binding.get(*this, motor)) ? Status::kOk
-                                                                                                 : Status::kEepromLocked;
-}
-
-Status Tmcm1636::restore_axis_parameter(uint8_t number, uint8_t motor) {
-  const auto* row = axis_parameters().find(number);
-  if (row == nullptr || !has(row->info.access, Access::kEeprom)) return Status::kWrongType;
-  const int32_t value = stored_value(kNvmLayout.axis_parameter(motor, number));
-  if (!params::in_range(row->info, value)) return Status::kInvalidValue;
-  return row->binding.set(*this, motor, value);
-}
-
-Status Tmcm1636::set_global_parameter(uint8_t number, uint8_t bank, int32_t value) {
-  if (bank == kBankUserVariables) {
-    user_variables_[number] = value;
-    return Status::kOk;
-  }
-  if (bank != kBankGlobal) return Status::kInvalidValue;
-  const auto* row = global_parameters().find(number);
-  if (row == nullptr || !has(row->info.access, Access::kAutoStore)) return global_parameters().write(*this, bank, number, value);
-  // Automatically stored (A): RAM and EEPROM change together or not at all.
-  const int32_t previous = row->binding.get != nullptr ? row->binding.get(*this, bank) : 0;
-  const Status status = global_parameters().write(*this, bank, number, value);
-  if (status != Status::kOk) return status;
-  if (!store_value(kNvmLayout.global_parameter(number), value)) {
-    row->binding.set(*this, bank, previous);
-    return Status::kEepromLocked;
-  }
-  return Status::kOk;
-}
-
-Status Tmcm1636::get_global_parameter(uint8_t number, uint8_t bank, int32_t& value) {
-  if (bank == kBankUserVariables) {
-    value = user_variables_[number];
-    return Status::kOk;
-  }
-  if (bank != kBankGlobal) return Status::kInvalidValue;
-  return global_parameters().read(*this, bank, number, value);
-}
-
-// STGP: user variables 0..55 (manual 4.2), and bank-0 parameters that are stored anyway.
-Status Tmcm1636::store_global_parameter(uint8_t number, uint8_t bank) {
-  if (bank == kBankUserVariables) {
-    if (number >= kStorableUserVariables) return Status::kWrongType;
-    return store_value(kNvmLayout.user_variable(number), user_variables_[number]) ? Status::kOk : Status::kEepromLocked;
-  }
-  if (bank != kBankGlobal) return Status::kInvalidValue;
-  const auto* row = global_parameters().find(number);
-  if (row == nullptr || !is_stored(row->info)) return Status::kWrongType;
-  return store_value(kNvmLayout.global_parameter(number), row->binding.get(*this, bank)) ? Status::kOk
-                                                                                          : Status::kEepromLocked;
-}
-
-Status Tmcm1636::restore_global_parameter(uint8_t number, uint8_t bank) {
-  if (bank == kBankUserVariables) {
-    if (number >= kStorableUserVariables) return Status::kWrongType;
-    user_variables_[number] = stored_value(kNvmLayout.user_variable(number));
-    return Status::kOk;
-  }
-  if (bank != kBankGlobal) return Status::kInvalidValue;
-  const auto* row = global_parameters().find(number);
-  if (row == nullptr || !is_stored(row->info)) return Status::kWrongType;
-  const int32_t value = stored_value(kNvmLayout.global_parameter(number));
-  if (!params::in_range(row->info, value)) return Status::kInvalidValue;
-  return row->binding.set(*this, bank, value);
-}
 
 Status Tmcm1636::set_output(uint8_t port, uint8_t bank, int32_t value) {
   if (bank != kIoBankDigitalOutputs) return Status::kInvalidValue;

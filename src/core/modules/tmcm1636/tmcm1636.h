@@ -14,6 +14,7 @@
 #include "core/params/parameter_table.h"
 #include "core/tmcl/device.h"
 #include "core/tmcl/engine.h"
+#include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
 
@@ -33,11 +34,12 @@ struct GlobalConfig {
   int32_t skip_user_variable_restore = 0;  // GP 85 (manual 6.4): 1 = user variables start at 0
 };
 
-inline constexpr size_t kUserVariableCount = 256;     // bank 2
+inline constexpr size_t kUserVariableCount = tmcl::kUserVariableCount;  // bank 2
 inline constexpr size_t kStorableUserVariables = 56;  // 0..55 (manual 4.2)
 inline constexpr size_t kProgramCapacity = 2048;      // instructions
 
-class Tmcm1636 final : public tmcl::TmclDevice {
+// Parameter commands, storage and power-up come from tmcl::ModuleStorage.
+class Tmcm1636 final : public tmcl::ModuleStorage<Tmcm1636> {
  public:
   static constexpr std::string_view kName = "tmcm-1636";
   static constexpr tmcl::FirmwareIdentity kIdentity{1636, 1, 9, "1636V109"};
@@ -50,8 +52,7 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   static const Table& axis_parameters();
   static const Table& global_parameters();  // bank 0
 
-  // Writes the factory image (every stored value at its default) into `image`.
-  static void format_factory_image(uint8_t* image, size_t size);
+  // format_factory_image(image, size): tmcl::ModuleStorage.
 
   // Does not touch `nvm` beyond reading it: call engine().power_up() to start.
   Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io);
@@ -70,8 +71,6 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   const Tmcm1636Axis& axis() const { return axis_; }
   GlobalConfig& global_config() { return global_; }
   board::Tmcm1636Io& io() { return io_; }
-  // True when the last EEPROM write failed (reported by the host runtime).
-  bool last_store_failed() const { return last_store_failed_; }
 
   // TmclDevice.
   const tmcl::FirmwareIdentity& identity() const override { return kIdentity; }
@@ -82,18 +81,8 @@ class Tmcm1636 final : public tmcl::TmclDevice {
   tmcl::Status stop(uint8_t motor) override;
   tmcl::Status move(uint8_t motor, uint8_t move_type, int32_t value) override;
   bool position_reached(uint8_t motor) const override;
-  tmcl::Status set_axis_parameter(uint8_t number, uint8_t motor, int32_t value) override;
-  tmcl::Status get_axis_parameter(uint8_t number, uint8_t motor, int32_t& value) override;
-  tmcl::Status store_axis_parameter(uint8_t number, uint8_t motor) override;
-  tmcl::Status restore_axis_parameter(uint8_t number, uint8_t motor) override;
-  tmcl::Status set_global_parameter(uint8_t number, uint8_t bank, int32_t value) override;
-  tmcl::Status get_global_parameter(uint8_t number, uint8_t bank, int32_t& value) override;
-  tmcl::Status store_global_parameter(uint8_t number, uint8_t bank) override;
-  tmcl::Status restore_global_parameter(uint8_t number, uint8_t bank) override;
   tmcl::Status set_output(uint8_t port, uint8_t bank, int32_t value) override;
   tmcl::Status get_input(uint8_t port, uint8_t bank, int32_t& value) override;
-  void restore_factory_defaults() override;
-  void power_up() override;
   tmcl::ProgramMemory* program_memory() override { return &program_; }
   bool autostart() const override { return global_.auto_start_mode != 0; }
   bool home_switch_active(uint8_t motor) const override;
@@ -101,22 +90,20 @@ class Tmcm1636 final : public tmcl::TmclDevice {
 
   // Used by the table bindings.
   void set_tick_timer_ms(uint32_t ms) { tick_timer_ms_ = ms; tick_fraction_ = 0; }
-  std::array<int32_t, kUserVariableCount>& user_variables() { return user_variables_; }
+
+  // tmcl::ModuleStorage hooks.
+  void clear_ram_state();
+  void after_axis_restore() { axis_.finish_restore(); }  // later writes are host commands
+  bool skip_user_variable_restore() const { return global_.skip_user_variable_restore != 0; }
 
  private:
-  bool store_value(uint32_t offset, int32_t value);
-  int32_t stored_value(uint32_t offset) const;
-
-  board::NonVolatileMemory& nvm_;
   board::Tmcm1636Io& io_;
   Tmcm1636Axis axis_;
   GlobalConfig global_;
-  std::array<int32_t, kUserVariableCount> user_variables_{};
   tmcl::TmclRuntime runtime_;
   uint64_t tick_count_ = 0;
   uint32_t tick_timer_ms_ = 0;
   uint32_t tick_fraction_ = 0;
-  bool last_store_failed_ = false;
   std::array<uint8_t, kProgramCapacity * tmcl::kProgramRecordBytes> program_mirror_{};
   tmcl::ProgramMemory program_{nvm_, kNvmLayout.program_offset, kProgramCapacity, program_mirror_.data()};
   // Last: it refers to the members above.

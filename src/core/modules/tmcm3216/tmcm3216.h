@@ -1,9 +1,9 @@
 // The TMCM-3216 with its CANopen firmware V1.04: the communication area of the object dictionary
 // (manual chapter 3), the node ID and bit rate objects 2704..2708 (4.2.62..4.2.66), NMT with
 // boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
-// memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour. PDO, SYNC,
-// LSS and the CiA-402 drive follow in later issues; the PDO
-// communication and mapping parameters are already here, as data, with the manual's defaults.
+// memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour, RPDOs and
+// TPDOs with the manual's numbering and defaults, SYNC (consumer; producer as a Motwin extension)
+// and the LSS slave. The CiA-402 drive follows in its own issue.
 #pragma once
 
 #include <array>
@@ -18,9 +18,12 @@
 #include "core/canopen/emergency.h"
 #include "core/canopen/heartbeat_consumer.h"
 #include "core/canopen/nmt.h"
+#include "core/canopen/lss_slave.h"
 #include "core/canopen/object_dictionary.h"
+#include "core/canopen/pdo.h"
 #include "core/canopen/sdo_server.h"
 #include "core/canopen/storage.h"
+#include "core/canopen/sync.h"
 
 namespace motwin::modules::tmcm3216 {
 
@@ -28,34 +31,27 @@ inline constexpr uint8_t kAxisCount = 3;
 inline constexpr uint8_t kPdosPerAxis = 4;       // RPDO/TPDO 1..4, 65..68, 129..132 (manual 1.1)
 inline constexpr uint8_t kMaxMappedObjects = 3;  // "dynamic mapping with max. three mapping entries"
 inline constexpr uint16_t kPdoAxisStride = 0x40; // 1400 -> 1440 -> 1480 (manual 3.1.15)
+inline constexpr size_t kPdoCount = kAxisCount * kPdosPerAxis;  // per direction; PDO K of axis n at n * 4 + K
 // The CANopen services run once per millisecond of simulated time (and at once whenever a frame
 // arrives, so that an SDO request is answered within the process() call that sees it).
 inline constexpr uint32_t kTickUs = 1000;
 
-struct PdoCommunication {
-  uint32_t cob_id;               // sub 1: bit 31 = not valid, bit 30 = no RTR
-  uint8_t transmission_type;     // sub 2: 1..240 synchronous, 254/255 event driven
-  uint16_t inhibit_time_100us;   // sub 3 (TPDO)
-  uint16_t event_timer_ms;       // sub 5 (TPDO)
-};
-
-struct PdoMapping {
-  uint8_t count;                                   // sub 0
-  uint32_t entries[kMaxMappedObjects];             // index << 16 | sub << 8 | bits
-};
+using PdoCommunication = canopen::PdoCommunication;
+using PdoMapping = canopen::PdoMapping;  // entries 1..kMaxMappedObjects used
 
 // The communication objects a master writes (1005..1029, 1400..1A03 of each axis).
 struct CommunicationConfig {
   uint32_t sync_cob_id;              // 1005
+  uint32_t sync_period_us;           // 1006
   uint32_t emcy_cob_id;              // 1014
   uint16_t emcy_inhibit_100us;       // 1015
   uint32_t consumer_heartbeat[1];    // 1016 sub 1
   uint16_t producer_heartbeat_ms;    // 1017
   uint8_t error_behavior[2];         // 1029 sub 1, 2
-  PdoCommunication rpdo[kAxisCount][kPdosPerAxis];
-  PdoMapping rpdo_mapping[kAxisCount][kPdosPerAxis];
-  PdoCommunication tpdo[kAxisCount][kPdosPerAxis];
-  PdoMapping tpdo_mapping[kAxisCount][kPdosPerAxis];
+  PdoCommunication rpdo[kPdoCount];
+  PdoMapping rpdo_mapping[kPdoCount];
+  PdoCommunication tpdo[kPdoCount];
+  PdoMapping tpdo_mapping[kPdoCount];
 };
 
 // 2704 / 2705: what applies after the next reset (2707 / 2708 show what applies now).
@@ -71,7 +67,7 @@ struct Tmcm3216Config {
   uint32_t serial_number = 0;  // 1018 sub 4
 };
 
-class Tmcm3216 {
+class Tmcm3216 final : private canopen::LssDevice {
  public:
   using Dictionary = canopen::TableDictionary<Tmcm3216>;
   using Row = canopen::EntryRow<Tmcm3216>;
@@ -119,12 +115,21 @@ class Tmcm3216 {
   canopen::NmtState nmt_state() const { return nmt_.state(); }
   uint8_t error_register() const { return error_register_; }
   uint64_t dropped_frames() const { return dropped_frames_; }
+  // Communication errors now active (kCommError* bits); 1001 bit 4 while any is.
+  uint8_t communication_errors() const { return communication_errors_; }
+  static constexpr uint8_t kCommErrorHeartbeat = 0x01;
+  static constexpr uint8_t kCommErrorCanOverrun = 0x02;
+  static constexpr uint8_t kCommErrorPdoLength = 0x04;
+  static constexpr uint8_t kCommErrorPdoLengthExceeded = 0x08;
 
   Dictionary& dictionary() { return dictionary_; }
   canopen::NmtSlave& nmt() { return nmt_; }
   canopen::SdoServer& sdo() { return sdo_; }
   canopen::EmergencyProducer& emergency() { return emergency_; }
   canopen::HeartbeatConsumer& heartbeat_consumer() { return heartbeat_consumer_; }
+  canopen::PdoService& pdos() { return pdos_; }
+  canopen::SyncService& sync() { return sync_; }
+  canopen::LssSlave& lss() { return lss_; }
   CommunicationConfig& communication() { return communication_; }
   NodeSettings& node_settings() { return node_settings_; }
   const Tmcm3216Config& config() const { return config_; }
@@ -140,6 +145,16 @@ class Tmcm3216 {
   void handle_frame(const can::CanFrame& frame);
   void run_nmt(uint32_t elapsed_us);
   void run_heartbeat_consumer(uint32_t elapsed_us);
+  void run_sync(uint32_t elapsed_us);
+  void handle_pdo(const can::CanFrame& frame);
+  void check_receive_overrun(uint32_t elapsed_us);
+  // Sets / clears one kCommError* bit, with its EMCY (code, or 0000 when it clears).
+  void raise_error(uint8_t error, uint16_t emcy_code);
+  void clear_error(uint8_t error);
+  canopen::LssIdentity identity() const;
+  // canopen::LssDevice.
+  bool lss_bit_rate_supported(uint16_t bit_rate_kbit) const override;
+  bool lss_store(uint8_t node_id, uint16_t bit_rate_kbit) override;
 
   board::NonVolatileMemory& nvm_;
   board::CanController& can_;
@@ -148,6 +163,7 @@ class Tmcm3216 {
   NodeSettings node_settings_{};
   uint8_t node_id_ = 1;
   uint16_t bit_rate_kbit_ = 1000;
+  uint16_t lss_bit_rate_kbit_ = 0;  // activated by LSS since power-up (0: none)
   uint8_t error_register_ = 0;
 
   Dictionary dictionary_;
@@ -155,6 +171,10 @@ class Tmcm3216 {
   canopen::SdoServer sdo_;
   canopen::EmergencyProducer emergency_;
   canopen::HeartbeatConsumer heartbeat_consumer_;
+  canopen::SyncService sync_;
+  canopen::PdoService pdos_;
+  canopen::LssSlave lss_;
+  uint8_t communication_errors_ = 0;
   std::array<uint8_t, kNvmSize> storage_scratch_{};
   canopen::ObjectStorage<Tmcm3216> storage_;
 
@@ -162,6 +182,7 @@ class Tmcm3216 {
   size_t receive_head_ = 0;
   size_t receive_count_ = 0;
   uint64_t dropped_frames_ = 0;
+  uint64_t reported_dropped_frames_ = 0;
 };
 
 }  // namespace motwin::modules::tmcm3216

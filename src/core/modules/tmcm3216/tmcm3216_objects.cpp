@@ -96,16 +96,17 @@ SdoAbort check_transmission_type(int64_t value) {
   return (value >= 1 && value <= 240) || value == 0xFE || value == 0xFF ? SdoAbort::kNone : SdoAbort::kInvalidValue;
 }
 
-bool pdo_valid(const PdoCommunication& pdo) { return (pdo.cob_id & kCobIdInvalid) == 0; }
+using canopen::pdo_valid;
 
 // A mapping entry `index << 16 | sub << 8 | bits` (CiA-301 7.5.2.36): the object exists, may be
-// mapped, and its size is `bits`. RPDOs may also map the dummy types 0002..0007 (sub 0).
+// mapped, and its size is `bits`. Both directions may map the dummy types 0002..0007 (sub 0): an
+// RPDO skips their bytes, a TPDO sends zeros (as CANopenNode).
 SdoAbort check_mapping_entry(Tmcm3216& device, bool receive, uint32_t entry) {
   const uint16_t index = static_cast<uint16_t>(entry >> 16);
-  const uint8_t sub = static_cast<uint8_t>(entry >> 8);
   const uint8_t bits = static_cast<uint8_t>(entry);
   if (bits == 0 || bits % 8 != 0) return SdoAbort::kNotMappable;
-  if (receive && index >= 0x0002 && index <= 0x0007 && sub == 0) {
+  const uint8_t sub = static_cast<uint8_t>(entry >> 8);
+  if (canopen::is_dummy_mapping(entry)) {
     return canopen::type_size(static_cast<DataType>(index)) * 8 == bits ? SdoAbort::kNone : SdoAbort::kNotMappable;
   }
   canopen::ObjectRef ref;
@@ -181,11 +182,13 @@ int64_t mapping_default(uint8_t axis) {
 
 template <size_t K, bool Receive>
 PdoCommunication& pdo_of(Tmcm3216& d, uint8_t axis) {
-  return Receive ? d.communication().rpdo[axis][K] : d.communication().tpdo[axis][K];
+  const size_t i = static_cast<size_t>(axis) * kPdosPerAxis + K;
+  return Receive ? d.communication().rpdo[i] : d.communication().tpdo[i];
 }
 template <size_t K, bool Receive>
 PdoMapping& mapping_of(Tmcm3216& d, uint8_t axis) {
-  return Receive ? d.communication().rpdo_mapping[axis][K] : d.communication().tpdo_mapping[axis][K];
+  const size_t i = static_cast<size_t>(axis) * kPdosPerAxis + K;
+  return Receive ? d.communication().rpdo_mapping[i] : d.communication().tpdo_mapping[i];
 }
 
 template <size_t K, bool Receive>
@@ -263,14 +266,32 @@ constexpr Binding restore_binding() {
   return b;
 }
 
-// 1005: bit 30 would make the module the SYNC producer, which it is not (manual 1.1: "SYNC:
-// consumer"); 29-bit identifiers are not supported (table 12).
+// 1005: bit 30 makes the module the SYNC producer (with 1006), a Motwin extension: the manual's
+// module is a consumer only (1.1), and the factory value keeps it one. 29-bit identifiers are not
+// supported (table 12).
 constexpr Binding sync_cob_id_binding() {
-  Binding b = canopen::field_binding<Tmcm3216, [](Tmcm3216& d, uint8_t) -> uint32_t& {
-    return d.communication().sync_cob_id;
-  }>();
+  Binding b;
+  b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().sync_cob_id); };
+  b.set = [](Tmcm3216& d, uint8_t, int64_t v) {
+    d.communication().sync_cob_id = static_cast<uint32_t>(v);
+    d.sync().set_cob_id(static_cast<uint32_t>(v));
+    return SdoAbort::kNone;
+  };
   b.check = [](Tmcm3216&, uint8_t, int64_t v) {
-    return (static_cast<uint32_t>(v) & ~kCobIdMask) != 0 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+    const uint32_t allowed = kCobIdMask | canopen::kSyncProducerBit;
+    return (static_cast<uint32_t>(v) & ~allowed) != 0 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+  };
+  return b;
+}
+
+// 1006 (CiA-301 7.5.2.6), µs; the producer's period when 1005 bit 30 is set.
+constexpr Binding sync_period_binding() {
+  Binding b;
+  b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().sync_period_us); };
+  b.set = [](Tmcm3216& d, uint8_t, int64_t v) {
+    d.communication().sync_period_us = static_cast<uint32_t>(v);
+    d.sync().set_cycle_period_us(static_cast<uint32_t>(v));
+    return SdoAbort::kNone;
   };
   return b;
 }
@@ -455,6 +476,8 @@ constexpr Table build_table() {
   t.add(var(0x1001, "Error register", kUnsigned8, Access::kRo, 0, kU8Max, 0,
             getter([](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.error_register()); })));
   t.add(var(0x1005, "COB-ID SYNC", kUnsigned32, Access::kRw, 0, kU32Max, 0x80, sync_cob_id_binding(), kComm));
+  t.add(var(0x1006, "Communication cycle period", kUnsigned32, Access::kRw, 0, kU32Max, 0, sync_period_binding(),
+            kComm));
   t.add(string_var(0x1008, "Manufacturer device name", [](Tmcm3216&, uint8_t) { return Tmcm3216::kDeviceName; }));
   t.add(string_var(0x1009, "Manufacturer hardware version",
                    [](Tmcm3216&, uint8_t) { return Tmcm3216::kHardwareVersion; }));

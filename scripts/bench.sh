@@ -1,0 +1,189 @@
+#!/usr/bin/env bash
+# The performance report: builds Motwin in Release (build-release/), runs every benchmark in
+# bench/ (bench/*.cpp, so benchmarks added later are picked up), measures the core's code size
+# with -Os -fno-exceptions -fno-rtti (build-minsize/), and writes a markdown report to stdout and
+# build-release/report.md. docs/PERFORMANCE.md explains how to read it.
+#
+#   scripts/bench.sh                 # the report (a few minutes)
+#   scripts/bench.sh --quick         # shorter runs (rough figures, for trying the script)
+#   MOTWIN_BENCH_BUILD=DIR scripts/bench.sh    # another build directory
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${MOTWIN_BENCH_BUILD:-build-release}
+minsize=${MOTWIN_BENCH_MINSIZE_BUILD:-build-minsize}
+jobs=$(nproc 2>/dev/null || echo 2)
+quick=0
+[ "${1:-}" = "--quick" ] && quick=1
+
+log() { echo "bench: $*" >&2; }
+
+mapfile -t benches < <(for f in bench/*.cpp; do basename "$f" .cpp; done)
+log "building Release in $build: motwin ${benches[*]}"
+# Release at -O2, the optimisation of the default build: at -O3 GCC 12 reports false
+# -Wrestrict and -Wmaybe-uninitialized inside std::string (GCC bugs 105329, 107138), which
+# -Werror turns into errors.
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS_RELEASE=-O2 -DNDEBUG" -DMOTWIN_BENCH=ON \
+  >/dev/null
+cmake --build "$build" -j"$jobs" --target motwin "${benches[@]}" >"$build/bench-build.log" 2>&1 ||
+  { tail -40 "$build/bench-build.log" >&2; exit 1; }
+log "building motwin_core with -Os in $minsize"
+cmake -S . -B "$minsize" -G Ninja -DCMAKE_BUILD_TYPE=MinSizeRel -DMOTWIN_BENCH=OFF >/dev/null
+cmake --build "$minsize" -j"$jobs" --target motwin_core >"$minsize/build.log" 2>&1 ||
+  { tail -40 "$minsize/build.log" >&2; exit 1; }
+
+logs="$build/bench-logs"
+rm -rf "$logs"
+mkdir -p "$logs"
+for bench in "${benches[@]}"; do
+  log "running $bench"
+  args=()
+  case "$bench" in
+    bench_tcp_roundtrip) [ $quick = 1 ] && args=(--requests 3000) ;;
+    bench_module_footprint) ;;
+    *)
+      # Google Benchmark programs; the others ignore unknown options only if they say so.
+      if grep -q 'benchmark/benchmark.h' "bench/$bench.cpp"; then
+        if [ $quick = 1 ]; then args=(--benchmark_min_time=0.1); else args=(--benchmark_repetitions=3); fi
+      fi
+      ;;
+  esac
+  if ! "$build/bench/$bench" "${args[@]}" >"$logs/$bench.txt" 2>"$logs/$bench.err"; then
+    log "$bench failed (exit status $?); its output is in $logs/"
+    echo "(failed: see $logs/$bench.err)" >>"$logs/$bench.txt"
+  fi
+done
+
+size -t "$minsize/libmotwin_core.a" >"$logs/core_size.txt"
+
+/usr/bin/python3 - "$logs" "$build/report.md" "${benches[@]}" <<'PYTHON'
+import datetime
+import os
+import platform
+import re
+import subprocess
+import sys
+
+logs, out_path, benches = sys.argv[1], sys.argv[2], sys.argv[3:]
+
+
+def text(name):
+    try:
+        with open(os.path.join(logs, name + ".txt")) as f:
+            return f.read()
+    except OSError:
+        return ""
+
+
+def summary(output):
+    """What a benchmark prints after Google Benchmark's table (its own figures against its
+    baseline), or the whole output for programs without such a table."""
+    lines = output.splitlines()
+    table_end = None
+    for i, line in enumerate(lines):
+        if re.match(r"^-{20,}$", line):
+            table_end = i
+    if table_end is None:
+        return output.strip()
+    rest = lines[table_end + 1:]
+    # Skip the table rows: up to the first blank line.
+    while rest and rest[0].strip():
+        rest = rest[1:]
+    return "\n".join(rest).strip()
+
+
+def cpu_model():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+rows = []  # (figure, value, baseline in the same run, ratio or note)
+
+tcp = text("bench_tcp_roundtrip")
+bare = re.search(r"bare 9-byte server.*?([\d.]+) us\s+([\d.]+) us", tcp)
+serve = re.search(r"motwin serve.*?([\d.]+) us\s+([\d.]+) us", tcp)
+ratio = re.search(r"ratio motwin / bare\s+([\d.]+)x\s+([\d.]+)x", tcp)
+if bare and serve and ratio:
+    rows.append(("TMCL round trip over TCP (GAP, median / p99)", f"{serve.group(1)} / {serve.group(2)} us",
+                 f"bare TCP echo {bare.group(1)} / {bare.group(2)} us", f"{ratio.group(1)}x / {ratio.group(2)}x"))
+else:
+    rows.append(("TMCL round trip over TCP", "n/a", "bare TCP echo", "bench_tcp_roundtrip failed or missing"))
+
+can = text("bench_can_roundtrip")
+can_row = r"\s+([\d.]+) us\s+([\d.]+) us\s+(\d+)\s+([\d.]+)x"
+can_bare = re.search(r"bare socketcand echo[^\n]*?" + can_row, can)
+can_found = False
+for label, pattern in (("SDO upload round trip over socketcand (TMCM-3216, median / p99)", r"motwin SDO upload[^\n]*?"),
+                       ("TMCL over CAN round trip via socketcand (TMCM-1636, median / p99)", r"motwin TMCL GAP over CAN[^\n]*?")):
+    m = re.search(pattern + can_row, can)
+    if m and can_bare:
+        can_found = True
+        rows.append((label, f"{m.group(1)} / {m.group(2)} us ({m.group(3)}/s)",
+                     f"bare socketcand echo {can_bare.group(1)} / {can_bare.group(2)} us ({can_bare.group(3)}/s)",
+                     f"{m.group(4)}x"))
+if not can_found:
+    rows.append(("SDO round trip over socketcand", "n/a", "bare socketcand echo",
+                 "bench_can_roundtrip failed or missing"))
+
+dispatch = text("bench_tmcl_dispatch")
+base = re.search(r"Relative to checksum_baseline \(([\d.]+) ns\)", dispatch)
+for m in re.finditer(r"serve_serial_frame/(\S+ \d+)[^\n]*?([\d.]+) ns\s+([\d.]+)x baseline\s+([\d.]+) M frames/s", dispatch):
+    rows.append((f"TMCL frames per second, core only ({m.group(1)})", f"{m.group(4)} M/s ({m.group(2)} ns)",
+                 f"checksum only {base.group(1) if base else '?'} ns", f"{m.group(3)}x"))
+
+for name in benches:
+    output = text(name)
+    header = re.search(r"Real-time factor[^\n]*\n((?:\s+\S+\s+[\d.]+x[^\n]*\n?)+)", output)
+    if not header:
+        continue
+    lines = header.group(1).strip().splitlines()
+    baseline = next((l.split() for l in lines if "baseline" in l.split()[0]), None)
+    for line in lines:
+        parts = line.split()
+        if baseline and parts[0] == baseline[0]:
+            continue
+        rows.append((f"simulation real-time factor, {name.replace('bench_', '')}: {parts[0]}", parts[1],
+                     f"{baseline[0]} {baseline[1]}" if baseline else "", " ".join(parts[2:]).replace("(", "").replace(")", "").strip()))
+
+interpreter = text("bench_interpreter")
+for m in re.finditer(r"^\s+(\S+)\s+([\d.]+) ms wall\s+([\d.]+)x real time\s+(?:([\d.]+)x baseline)?", interpreter, re.M):
+    rows.append((f"TMCM-1636 module in fast pacing, interpreter: {m.group(1)}", f"{m.group(3)}x real time",
+                 "idle_module_baseline" if m.group(4) else "(baseline)", f"{m.group(4)}x" if m.group(4) else ""))
+
+sizes = text("core_size")
+total = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+\S+\s+\(TOTALS\)", sizes, re.M)
+if total:
+    rows.append(("core code size (-Os -fno-exceptions -fno-rtti, libmotwin_core.a)", f"{int(total.group(1))} B text",
+                 f"{total.group(2)} B data, {total.group(3)} B bss", ""))
+
+footprint = text("bench_module_footprint")
+
+now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True).stdout
+load = os.getloadavg()[0]
+report = [f"# Motwin performance report", "",
+          f"{now}, commit {commit or '?'}{' (with uncommitted changes)' if dirty.strip() else ''}; "
+          f"{os.cpu_count()} CPUs, {cpu_model()}; load average {load:.1f} at the end; Release build.", "",
+          "Every figure comes with its baseline measured in the same run; compare ratios across machines "
+          "(docs/PERFORMANCE.md).", "",
+          "| figure | value | baseline (same run) | ratio / note |", "|---|---|---|---|"]
+report += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
+report += ["", "## Memory per module instance and whole-module simulation speed", "",
+           footprint.strip() or "(bench_module_footprint missing)", ""]
+report += ["## Each benchmark's own summary", ""]
+for name in benches:
+    if name == "bench_module_footprint":
+        continue
+    report += [f"### {name}", "", "```", summary(text(name)) or "(no output)", "```", ""]
+result = "\n".join(report) + "\n"
+with open(out_path, "w") as f:
+    f.write(result)
+sys.stdout.write(result)
+PYTHON
+log "report written to $build/report.md"

@@ -1,0 +1,93 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets of fuzz/ with clang (ASan + UBSan) in build-fuzz/ and runs them.
+#
+#   scripts/fuzz.sh TARGET [SECONDS]    one target, default 600 s; its corpus grows in
+#                                       build-fuzz/corpus/TARGET (seeds: fuzz/corpus/TARGET)
+#   scripts/fuzz.sh all [SECONDS]       every target in turn, SECONDS each (default 600)
+#   scripts/fuzz.sh --smoke [SECONDS]   the test command's bounded run: every target SECONDS each
+#                                       (default 6) from the seeds, in a scratch corpus
+#   scripts/fuzz.sh --list              the targets
+#
+# A crash or a violated invariant stops the run with exit status 1 and leaves the input in
+# build-fuzz/artifacts/; replay it with `build-fuzz/fuzz_TARGET FILE`. MOTWIN_FUZZ_BUILD names
+# another build directory. See fuzz/README.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=${MOTWIN_FUZZ_BUILD:-build-fuzz}
+jobs=$(nproc 2>/dev/null || echo 2)
+
+usage() {
+  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//' >&2
+  exit 2
+}
+[ $# -ge 1 ] || usage
+mode=$1
+seconds=${2:-}
+
+if ! command -v clang++ >/dev/null; then
+  echo "fuzz: clang++ is not installed (scripts/install-deps.sh installs it)" >&2
+  exit 1
+fi
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ -DMOTWIN_FUZZ=ON \
+  -DMOTWIN_BENCH=OFF >/dev/null
+if ! cmake --build "$build" -j"$jobs" >"$build/build.log" 2>&1; then
+  grep -E -B2 -A8 'error|FAILED' "$build/build.log" | head -60 >&2
+  echo "fuzz: the build failed (log $build/build.log)" >&2
+  exit 1
+fi
+mapfile -t targets <"$build/fuzz_targets.txt"
+
+# Leaks are findings too; a slow input (> 10 s) is a hang.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+mkdir -p "$build/artifacts"
+
+run_target() {  # target seconds corpus-dir
+  local target=$1 time=$2 corpus=$3 log
+  mkdir -p "$corpus"
+  log="$build/artifacts/$target.log"
+  local start=$SECONDS
+  if "$build/fuzz_$target" -max_total_time="$time" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$build/artifacts/$target-" "$corpus" "fuzz/corpus/$target" >"$log" 2>&1; then
+    local runs
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+    printf '  %-22s ok   %8s inputs in %3d s\n' "$target" "$runs" $((SECONDS - start))
+    return 0
+  fi
+  printf '  %-22s FAILED (log %s)\n' "$target" "$log"
+  grep -E -A12 'invariant violated|ERROR: |SUMMARY' "$log" | head -40 | sed 's/^/    /'
+  grep -o "Test unit written to .*" "$log" | sed "s|Test unit written to |    reproduce: $build/fuzz_$target |"
+  return 1
+}
+
+case "$mode" in
+  --list)
+    printf '%s\n' "${targets[@]}"
+    ;;
+  --smoke)
+    status=0
+    rm -rf "$build/smoke-corpus"
+    for target in "${targets[@]}"; do
+      run_target "$target" "${seconds:-6}" "$build/smoke-corpus/$target" || status=1
+    done
+    exit $status
+    ;;
+  all)
+    status=0
+    for target in "${targets[@]}"; do
+      run_target "$target" "${seconds:-600}" "$build/corpus/$target" || status=1
+    done
+    exit $status
+    ;;
+  -*)
+    usage
+    ;;
+  *)
+    if ! printf '%s\n' "${targets[@]}" | grep -qx "$mode"; then
+      echo "fuzz: no target '$mode'; targets: ${targets[*]}" >&2
+      exit 2
+    fi
+    run_target "$mode" "${seconds:-600}" "$build/corpus/$mode"
+    ;;
+esac

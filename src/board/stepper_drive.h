@@ -1,0 +1,50 @@
+// Board seam of one stepper axis (the TMCM-142's axis, each of the TMCM-3216's three): the
+// motor driver stage and the motor-side sensors, as plain data read and written once per
+// control tick, like the registers of a real driver chip and encoder counter. The per-tick path
+// has no virtual call and no knowledge of the plant.
+//
+// The simulated board (sim::StepperPlant and the module's sim board) fills `feedback` before
+// each tick and applies `drive` after it; a real board would fill the same fields from its
+// peripherals.
+#pragma once
+
+#include <cstdint>
+
+namespace motwin::board {
+
+// One electrical revolution of a two-phase stepper is four full steps.
+inline constexpr uint64_t kElectricalAngleFullCircle = uint64_t{1} << 32;
+inline constexpr uint32_t kElectricalAnglePerFullStep = uint32_t{1} << 30;
+
+// Sampled at the start of each control tick.
+struct StepperFeedback {
+  // ABN encoder: the quadrature counter (free running, wraps at 32 bits), the number of N pulses
+  // seen so far (wraps) and the counter value latched by the last N pulse.
+  int32_t encoder_count = 0;
+  uint32_t encoder_index_events = 0;
+  int32_t encoder_index_count = 0;
+  // Switch inputs as electrical levels: bit 0 right limit, bit 1 left limit, bit 2 home.
+  uint8_t switches = 0;
+  // Motor supply voltage, mV.
+  int32_t supply_millivolt = 24000;
+};
+
+// Applied from the next tick on.
+struct StepperDrive {
+  // false: the bridges are open and the motor freewheels.
+  bool enabled = false;
+  // The driver's microstep counter as an electrical angle: 2^32 per electrical revolution
+  // (4 full steps), wrapping. Moves by at most a quarter revolution per tick.
+  uint32_t electrical_angle = 0;
+  // Coil current targets from the microstep table at the present current amplitude, signed, mA
+  // (peak). Coil A follows the cosine, coil B the sine of the electrical angle.
+  int32_t coil_a_ma = 0;
+  int32_t coil_b_ma = 0;
+};
+
+struct StepperPowerStage {
+  StepperFeedback feedback;
+  StepperDrive drive;
+};
+
+}  // namespace motwin::board

@@ -1,0 +1,166 @@
+#include "core/canopen/pdo.h"
+
+namespace motwin::canopen {
+namespace {
+
+uint16_t mapped_index(uint32_t entry) { return static_cast<uint16_t>(entry >> 16); }
+uint8_t mapped_sub(uint32_t entry) { return static_cast<uint8_t>(entry >> 8); }
+uint8_t mapped_bits(uint32_t entry) { return static_cast<uint8_t>(entry); }
+
+}  // namespace
+
+PdoService::PdoService(ObjectDictionary& dictionary, board::CanController& can,
+                       std::span<const PdoCommunication> rpdo, std::span<const PdoMapping> rpdo_mapping,
+                       std::span<const PdoCommunication> tpdo, std::span<const PdoMapping> tpdo_mapping)
+    : dictionary_(dictionary),
+      can_(can),
+      rpdo_(rpdo.first(rpdo.size() < kMaxPdos ? rpdo.size() : kMaxPdos)),
+      rpdo_mapping_(rpdo_mapping),
+      tpdo_(tpdo.first(tpdo.size() < kMaxPdos ? tpdo.size() : kMaxPdos)),
+      tpdo_mapping_(tpdo_mapping) {}
+
+void PdoService::reset() {
+  for (ReceiveState& r : receive_) r = ReceiveState{};
+  for (TransmitState& t : transmit_) t = TransmitState{};
+}
+
+void PdoService::enter_operational() {
+  reset();
+  for (size_t i = 0; i < tpdo_.size(); ++i) {
+    const PdoCommunication& pdo = tpdo_[i];
+    if (!pdo_valid(pdo) || pdo_synchronous(pdo)) continue;
+    transmit_[i].due = true;
+    transmit_[i].event_remaining_us = static_cast<uint64_t>(pdo.event_timer_ms) * 1000u;
+  }
+}
+
+bool PdoService::mapped_length(const PdoMapping& mapping, bool receive, size_t& bytes) const {
+  bytes = 0;
+  if (mapping.count > kMaxPdoMappedObjects) return false;
+  for (uint8_t e = 0; e < mapping.count; ++e) {
+    const uint32_t entry = mapping.entries[e];
+    const uint8_t bits = mapped_bits(entry);
+    if (bits == 0 || bits % 8 != 0) return false;
+    if (!is_dummy_mapping(entry)) {
+      ObjectRef ref;
+      if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return false;
+      if (receive ? !writable(ref.info->access) : !readable(ref.info->access)) return false;
+      if (type_size(ref.info->type) * 8u != bits) return false;
+    }
+    bytes += bits / 8u;
+  }
+  return bytes <= 8;
+}
+
+RpdoReception PdoService::on_frame(const can::CanFrame& frame) {
+  if (frame.extended || frame.rtr) return RpdoReception::kNotPdo;
+  for (size_t i = 0; i < rpdo_.size(); ++i) {
+    const PdoCommunication& pdo = rpdo_[i];
+    if (!pdo_valid(pdo) || (pdo.cob_id & 0x7FF) != frame.id) continue;
+    size_t bytes = 0;
+    if (!mapped_length(rpdo_mapping_[i], true, bytes)) return RpdoReception::kAccepted;  // inactive: ignored
+    if (frame.dlc < bytes) return RpdoReception::kTooShort;
+    if (pdo_synchronous(pdo)) {
+      ReceiveState& state = receive_[i];
+      state.pending = true;
+      state.dlc = frame.dlc;
+      for (uint8_t b = 0; b < 8; ++b) state.data[b] = frame.data[b];
+    } else {
+      write_mapped(rpdo_mapping_[i], frame.data);
+    }
+    return frame.dlc > bytes ? RpdoReception::kTooLong : RpdoReception::kAccepted;
+  }
+  return RpdoReception::kNotPdo;
+}
+
+void PdoService::write_mapped(const PdoMapping& mapping, const uint8_t* data) {
+  size_t offset = 0;
+  for (uint8_t e = 0; e < mapping.count; ++e) {
+    const uint32_t entry = mapping.entries[e];
+    const size_t bytes = mapped_bits(entry) / 8u;
+    ObjectRef ref;
+    // A value the object refuses (out of its range) is dropped; the other objects are written.
+    if (!is_dummy_mapping(entry) && dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) == SdoAbort::kNone) {
+      dictionary_.write(ref, data + offset, bytes);
+    }
+    offset += bytes;
+  }
+}
+
+bool PdoService::sample(const PdoMapping& mapping, uint8_t (&out)[8], size_t& length) {
+  length = 0;
+  size_t bytes = 0;
+  if (!mapped_length(mapping, false, bytes)) return false;
+  for (uint8_t e = 0; e < mapping.count; ++e) {
+    const uint32_t entry = mapping.entries[e];
+    const size_t size = mapped_bits(entry) / 8u;
+    if (is_dummy_mapping(entry)) {
+      for (size_t b = 0; b < size; ++b) out[length + b] = 0;
+    } else {
+      ObjectRef ref;
+      size_t read = 0;
+      if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return false;
+      if (dictionary_.read(ref, out + length, 8 - length, read) != SdoAbort::kNone || read != size) return false;
+    }
+    length += size;
+  }
+  return true;
+}
+
+void PdoService::transmit(size_t i, const uint8_t* data, size_t length) {
+  TransmitState& state = transmit_[i];
+  const can::CanFrame frame = can::make_frame(tpdo_[i].cob_id & 0x7FF, data, static_cast<uint8_t>(length));
+  can_.transmit(frame);
+  ++transmitted_;
+  state.sent = true;
+  state.due = false;
+  state.length = static_cast<uint8_t>(length);
+  for (size_t b = 0; b < length; ++b) state.last[b] = data[b];
+  state.inhibit_remaining_us = static_cast<uint64_t>(tpdo_[i].inhibit_time_100us) * 100u;
+  state.event_remaining_us = static_cast<uint64_t>(tpdo_[i].event_timer_ms) * 1000u;
+}
+
+void PdoService::on_sync() {
+  for (size_t i = 0; i < rpdo_.size(); ++i) {
+    ReceiveState& state = receive_[i];
+    if (!state.pending) continue;
+    state.pending = false;
+    if (pdo_valid(rpdo_[i]) && pdo_synchronous(rpdo_[i])) write_mapped(rpdo_mapping_[i], state.data);
+  }
+  for (size_t i = 0; i < tpdo_.size(); ++i) {
+    const PdoCommunication& pdo = tpdo_[i];
+    if (!pdo_valid(pdo) || !pdo_synchronous(pdo)) continue;
+    TransmitState& state = transmit_[i];
+    if (++state.sync_count < pdo.transmission_type) continue;
+    state.sync_count = 0;
+    uint8_t data[8] = {};
+    size_t length = 0;
+    if (sample(tpdo_mapping_[i], data, length)) transmit(i, data, length);
+  }
+}
+
+void PdoService::process(uint32_t elapsed_us) {
+  for (size_t i = 0; i < tpdo_.size(); ++i) {
+    const PdoCommunication& pdo = tpdo_[i];
+    TransmitState& state = transmit_[i];
+    if (!pdo_valid(pdo) || pdo_synchronous(pdo)) continue;
+    state.inhibit_remaining_us = elapsed_us < state.inhibit_remaining_us ? state.inhibit_remaining_us - elapsed_us : 0;
+    if (pdo.event_timer_ms != 0) {
+      if (elapsed_us >= state.event_remaining_us) {
+        state.due = true;
+        state.event_remaining_us = 0;
+      } else {
+        state.event_remaining_us -= elapsed_us;
+      }
+    }
+    uint8_t data[8] = {};
+    size_t length = 0;
+    if (!sample(tpdo_mapping_[i], data, length)) continue;
+    bool changed = !state.sent || length != state.length;
+    for (size_t b = 0; b < length && !changed; ++b) changed = data[b] != state.last[b];
+    if (changed) state.due = true;
+    if (state.due && state.inhibit_remaining_us == 0) transmit(i, data, length);
+  }
+}
+
+}  // namespace motwin::canopen

@@ -1,0 +1,153 @@
+// The axis of the TMCM-142: TMC457-style S-ramp (motion/s_ramp.h), microstep sequencer and coil
+// currents into the stepper power stage (board/stepper_drive.h), limit switches, ABN encoder with
+// the easyPID closed loop and the encoder deviation stop, standby current, and the reference
+// search. Reads only the feedback fields of the stage and writes only its drive fields.
+#pragma once
+
+#include <cstdint>
+
+#include "board/stepper_drive.h"
+#include "core/modules/tmcm142/tmcm142_hardware.h"
+#include "core/motion/easy_pid.h"
+#include "core/motion/reference_search.h"
+#include "core/motion/s_ramp.h"
+
+namespace motwin::modules::tmcm142 {
+
+// Default velocities and accelerations in µsteps/s (the table's defaults are the same values in
+// TMC457 units, unit mode 0).
+inline constexpr int32_t kDefaultMaxVelocity = 13743895;      // AP 4: 204800 µsteps/s, 1 rev/s at 1024
+inline constexpr int32_t kDefaultAcceleration = 14073;        // AP 5: 204786 µsteps/s²
+inline constexpr int32_t kDefaultBow = 1000;                  // AP 16..19: 1.42e7 µsteps/s³
+inline constexpr int32_t kDefaultReferenceSlow = kDefaultMaxVelocity / 4;  // AP 195
+
+// Stored settings (the E parameters). Velocities and accelerations are kept in µsteps/s and
+// µsteps/s² whatever the unit mode, so AP 255 changes only how they are read and written.
+struct AxisConfig {
+  double max_velocity_pps = kDefaultMaxVelocity * kPpsPerVelocityUnit;        // AP 4
+  double acceleration_pps2 = kDefaultAcceleration * kPps2PerAccelerationUnit;  // AP 5
+  int32_t run_current_code = 5;           // AP 6: (c + 1) * 7000 / 16 mA peak
+  int32_t standby_current_code = 1;       // AP 7
+  int32_t right_switch_disable = 0;       // AP 12
+  int32_t left_switch_disable = 0;        // AP 13
+  int32_t switch_mode = 0;                // AP 14: bit 2 left polarity, 3 right polarity, 4 swap, 5 soft stop
+  double stop_deceleration_pps2 = kDefaultAcceleration * kPps2PerAccelerationUnit;  // AP 15
+  int32_t bow[4] = {kDefaultBow, kDefaultBow, kDefaultBow, kDefaultBow};             // AP 16..19
+  int32_t microstep_code = kFinestResolutionCode;  // AP 27
+  motion::EasyPidConfig pid{65536, 0, 0, 0, 0, 67108864};  // AP 30, 31, 32, 33, 35, 37
+  int32_t pid_mode = 0;                   // AP 40
+  int32_t encoder_constant = 3355443;     // AP 42: µsteps per encoder count * 65536 (51.2)
+  int32_t encoder_direction = 0;          // AP 46
+  int32_t reference_mode = 1;             // AP 193
+  double reference_fast_pps = kDefaultMaxVelocity * kPpsPerVelocityUnit;    // AP 194
+  double reference_slow_pps = kDefaultReferenceSlow * kPpsPerVelocityUnit;  // AP 195
+  int32_t max_encoder_deviation = 0;      // AP 212, µsteps; 0 = off
+  int32_t standby_delay_10ms = 200;       // AP 214
+  int32_t unit_mode = 0;                  // AP 255
+};
+
+// AP 14 bits.
+namespace switch_mode {
+inline constexpr int32_t kInvertLeft = 1 << 2;
+inline constexpr int32_t kInvertRight = 1 << 3;
+inline constexpr int32_t kSwap = 1 << 4;
+inline constexpr int32_t kSoftStop = 1 << 5;
+}  // namespace switch_mode
+
+// AP 129 bits.
+namespace status_flag {
+inline constexpr int32_t kPositionReached = 1 << 0;
+inline constexpr int32_t kVelocityReached = 1 << 1;
+inline constexpr int32_t kStandstill = 1 << 2;
+inline constexpr int32_t kEncoderDeviation = 1 << 3;
+}  // namespace status_flag
+
+// AP 207 bits (cleared on read).
+namespace error_flag {
+inline constexpr int32_t kDeviationStop = 1 << 1;
+}  // namespace error_flag
+
+// AP 128.
+enum class RampMode : int32_t { kPosition = 0, kVelocity = 2, kHold = 3 };
+
+struct AxisState {
+  double target_velocity_pps = 0.0;  // AP 2
+  int32_t right_switch_active = 0;   // AP 10
+  int32_t left_switch_active = 0;    // AP 11
+  int32_t home_switch_active = 0;
+  int32_t error_flags = 0;           // AP 207
+  int32_t travel = 0;                // AP 196
+  int32_t encoder_position = 0;      // AP 41
+  bool deviation_exceeded = false;
+  bool standby = false;
+};
+
+class Tmcm142Axis {
+ public:
+  AxisConfig config;
+  AxisState state;
+
+  // Commands.
+  void set_target_position(int32_t position);
+  void set_actual_position(int32_t position);
+  void set_target_velocity(double velocity_pps);
+  int32_t set_ramp_mode(int32_t mode);  // 0 ok, else the TMCL status 4
+  void stop();                          // MST: velocity 0 with the ramp
+  void set_encoder_position(int32_t position);
+  void start_reference_search();
+  void stop_reference_search();
+
+  // One control tick on the power stage: feedback in, drive out.
+  void tick(board::StepperPowerStage& stage);
+
+  // Power-up: live state cleared, settings kept; the rotor stays where it is.
+  void reset_state();
+
+  RampMode ramp_mode() const;
+  int32_t actual_position() const { return ramp_.position(); }
+  int32_t target_position() const { return ramp_.target_position(); }
+  double actual_velocity_pps() const { return ramp_.velocity(); }
+  bool position_reached() const { return ramp_.mode() == motion::SRamp::Mode::kPosition && ramp_.position_reached(); }
+  bool velocity_reached() const { return ramp_.velocity_reached(); }
+  bool reference_search_running() const { return search_.running(); }
+  int32_t status_flags() const;
+  // AP 207: read and clear.
+  int32_t take_error_flags();
+  // True once per deviation stop (the module raises the TMCL EDV flag).
+  bool take_deviation_event();
+  uint32_t microsteps_per_full_step() const { return microsteps_of_code(config.microstep_code); }
+  int32_t coil_current_ma() const { return current_of(state.standby ? config.standby_current_code : config.run_current_code); }
+  const motion::EasyPidState& pid_state() const { return pid_; }
+  void clear_pid_sum() { pid_.error_sum = 0; }
+  // pid_v_actual (AP 39): ramp velocity plus correction, TMC457 units.
+  int64_t pid_velocity_internal() const;
+  const motion::SRamp& ramp() const { return ramp_; }
+
+ private:
+  static int32_t current_of(int32_t code) { return current_ma_of_code(code); }
+  void read_feedback(const board::StepperFeedback& feedback);
+  void run_reference_search();
+  void apply_switch_stops();
+  void check_deviation();
+  motion::SRampConfig ramp_config() const;
+  void write_drive(board::StepperDrive& drive, int64_t ramp_delta_q32);
+
+  motion::SRamp ramp_;
+  motion::ReferenceSearch search_;
+  motion::EasyPidState pid_;
+  bool search_final_move_ = false;
+  bool switch_stopping_ = false;   // soft stop at a switch: AP 15 deceleration until at rest
+  bool deviation_event_ = false;
+  // Encoder: last raw count and the position in 1/65536 µsteps.
+  bool encoder_started_ = false;
+  int32_t encoder_last_count_ = 0;
+  int64_t encoder_position_q16_ = 0;
+  // The microstep sequencer: electrical angle x 2^16 (only the low 48 bits matter). It follows
+  // the ramp's motion (not its counter, so setting AP 1 never moves the field) plus the easyPID
+  // correction.
+  uint64_t angle_q16_ = 0;
+  uint64_t last_ramp_q32_ = 0;
+  uint32_t standstill_ticks_ = 0;
+};
+
+}  // namespace motwin::modules::tmcm142

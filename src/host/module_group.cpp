@@ -1,0 +1,169 @@
+#include "host/module_group.h"
+
+#include <charconv>
+#include <cstdlib>
+#include <numeric>
+#include <set>
+
+#include "core/tmcl/can_link.h"
+#include "host/tmcl_can_node.h"
+
+namespace motwin::host {
+namespace {
+
+std::optional<long> parse_number(std::string_view text) {
+  long value = 0;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || result.ec != std::errc{} || result.ptr != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+bool valid_name(std::string_view name) {
+  if (name.empty() || name == "." || name == "..") return false;
+  for (const char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<NodeSpec> parse_node_spec(std::string_view text, size_t position, std::string& error) {
+  NodeSpec spec;
+  const size_t colon = text.find(':');
+  spec.module = std::string(text.substr(0, colon));
+  if (find_module(spec.module) == nullptr) {
+    error = "unknown module \"" + spec.module + "\" (available: " + module_names() + ")";
+    return std::nullopt;
+  }
+  spec.name = spec.module + "-" + std::to_string(position);
+  std::string_view rest = colon == std::string_view::npos ? std::string_view{} : text.substr(colon + 1);
+  while (!rest.empty()) {
+    const size_t comma = rest.find(',');
+    const std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    const size_t equals = item.find('=');
+    const std::string_view key = item.substr(0, equals);
+    const std::string_view value = equals == std::string_view::npos ? std::string_view{} : item.substr(equals + 1);
+    if (equals == std::string_view::npos || value.empty()) {
+      error = "expected KEY=VALUE, got \"" + std::string(item) + "\"";
+      return std::nullopt;
+    }
+    const std::optional<long> number = parse_number(value);
+    if (key == "name") {
+      if (!valid_name(value)) {
+        error = "name \"" + std::string(value) + "\": letters, digits, '-', '_' and '.' only";
+        return std::nullopt;
+      }
+      spec.name = std::string(value);
+    } else if (key == "node-id") {
+      if (!number || *number < 1 || *number > 127) {
+        error = "node-id must be 1..127, got \"" + std::string(value) + "\"";
+        return std::nullopt;
+      }
+      spec.node_id = static_cast<uint8_t>(*number);
+    } else if (key == "serial") {
+      if (!number || *number < 1 || *number > 0xFFFFFFFFL) {
+        error = "serial must be 1..4294967295, got \"" + std::string(value) + "\"";
+        return std::nullopt;
+      }
+      spec.serial_number = static_cast<uint32_t>(*number);
+    } else if (key == "motor") {
+      spec.motor = std::string(value);
+    } else if (key == "receive-id" || key == "send-id") {
+      if (!number || *number < 0 || *number > 255) {
+        error = std::string(key) + " must be 0..255 (GP 70/71), got \"" + std::string(value) + "\"";
+        return std::nullopt;
+      }
+      (key == "receive-id" ? spec.receive_id : spec.send_id) = static_cast<int32_t>(*number);
+    } else {
+      error = "unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, receive-id, send-id)";
+      return std::nullopt;
+    }
+  }
+  return spec;
+}
+
+ModuleGroup::MakeResult ModuleGroup::make(const std::vector<NodeSpec>& specs,
+                                          const std::optional<std::filesystem::path>& state_dir, LogSink log) {
+  MakeResult result;
+  if (specs.empty()) {
+    result.error = "no nodes";
+    return result;
+  }
+  std::set<std::string> names;
+  for (const NodeSpec& spec : specs) {
+    if (!names.insert(spec.name).second) {
+      result.error = "two nodes named \"" + spec.name + "\" (give one a name=...)";
+      return result;
+    }
+  }
+  std::unique_ptr<ModuleGroup> group(new ModuleGroup());
+  uint32_t period = 0;
+  for (const NodeSpec& spec : specs) {
+    ModuleOptions options;
+    if (state_dir) options.state_dir = *state_dir / spec.name;
+    options.node_id = spec.node_id;
+    options.serial_number = spec.serial_number;
+    options.motor = spec.motor;
+    options.log = log;
+    MakeModuleResult made = make_module(spec.module, options);
+    if (!made.module) {
+      result.error = spec.name + ": " + made.error;
+      return result;
+    }
+    VirtualModule& module = *made.module;
+    if (module.can_node() == nullptr) {
+      result.error = spec.name + ": " + spec.module + " has no CAN interface";
+      return result;
+    }
+    if (spec.receive_id >= 0 || spec.send_id >= 0) {
+      if (!module.has_tmcl()) {
+        result.error = spec.name + ": receive-id/send-id are for TMCL modules (use node-id)";
+        return result;
+      }
+      // As a user would set them once with SGP: GP 70/71 are stored automatically.
+      const auto set = [&module](uint8_t number, int32_t value) {
+        return module.engine().execute(tmcl::Instruction{tmcl::command::kSgp, number, 0, value}, tmcl::Origin::kHost).status;
+      };
+      if ((spec.receive_id >= 0 && set(tmcl::can_parameter::kReceiveId, spec.receive_id) != tmcl::Status::kOk) ||
+          (spec.send_id >= 0 && set(tmcl::can_parameter::kSendId, spec.send_id) != tmcl::Status::kOk)) {
+        result.error = spec.name + ": cannot set the CAN IDs";
+        return result;
+      }
+    }
+    period = std::gcd(period, module.tick_period_us());
+    group->members_.push_back(Member{spec.name, std::move(made.module)});
+  }
+  group->tick_period_us_ = period == 0 ? 1 : period;
+  result.group = std::move(group);
+  return result;
+}
+
+tmcl::TmclEngine& ModuleGroup::engine() { std::abort(); }
+
+void ModuleGroup::run_ticks(uint64_t count) {
+  tick_count_ += count;
+  const uint64_t now_us = tick_count_ * tick_period_us_;
+  for (Member& member : members_) {
+    VirtualModule& module = *member.module;
+    const uint64_t target_ticks = now_us / module.tick_period_us();
+    if (target_ticks > module.tick_count()) module.run_ticks(target_ticks - module.tick_count());
+    // Nobody serves TMCL over TCP here: the CAN link collects its own command 138 replies.
+    if (TmclCanNode* can = module.tmcl_can_node()) can->deliver_events();
+    discarded_outputs_.clear();
+    module.signals().take_output_changes(discarded_outputs_);
+  }
+}
+
+std::string ModuleGroup::nvm_location() const {
+  std::string text;
+  for (const Member& member : members_) {
+    if (!text.empty()) text += ", ";
+    text += member.name + "=" + member.module->nvm_location();
+  }
+  return text;
+}
+
+}  // namespace motwin::host

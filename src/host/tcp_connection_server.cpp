@@ -1,0 +1,225 @@
+#include "host/tcp_connection_server.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+
+namespace motwin::host {
+namespace {
+
+// While the process is out of descriptors, accepting is retried this much later instead of
+// spinning on a listening socket that stays readable.
+constexpr uint64_t kAcceptRetryUs = 100'000;
+// Sent output is dropped from the front of the buffer once this much has piled up.
+constexpr size_t kCompactOutputBytes = 64 * 1024;
+
+}  // namespace
+
+void TcpSession::on_input_closed() { connection().close("closed by the client"); }
+
+TcpConnection::TcpConnection(TcpConnectionServer& server, uint64_t id, int fd, std::string peer)
+    : server_(server), id_(id), fd_(fd), peer_(std::move(peer)) {}
+
+TcpConnection::~TcpConnection() { ::close(fd_); }
+
+void TcpConnection::on_events(short revents) {
+  if ((revents & POLLOUT) != 0) flush();
+  if (closing_) return;
+  if ((revents & (POLLIN | POLLHUP | POLLERR)) == 0) return;
+  if (session_->read_budget() == 0) {
+    // Not reading (back-pressure or input closed) yet the socket failed: nothing left to wait for.
+    if ((revents & (POLLHUP | POLLERR)) != 0) close("connection lost");
+    return;
+  }
+  read_some();
+}
+
+void TcpConnection::read_some() {
+  uint8_t buffer[TcpSession::kReadChunkBytes];
+  const size_t budget = std::min(sizeof(buffer), session_->read_budget());
+  if (budget == 0) return;
+  ssize_t n = 0;
+  do {
+    n = ::recv(fd_, buffer, budget, 0);
+  } while (n < 0 && errno == EINTR);
+  if (n < 0) {
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return;
+    close(std::strerror(errno));
+    return;
+  }
+  if (n == 0) {
+    session_->on_input_closed();
+    return;
+  }
+  session_->on_data(buffer, static_cast<size_t>(n));
+  update_events();
+}
+
+void TcpConnection::write(const void* bytes, size_t length) {
+  if (closing_ || length == 0) return;
+  if (pending_output() + length > server_.config_.max_pending_output_bytes) {
+    close(server_.config_.overflow_reason);
+    return;
+  }
+  const auto* first = static_cast<const uint8_t*>(bytes);
+  output_.insert(output_.end(), first, first + length);
+  flush();
+}
+
+void TcpConnection::hold_output(bool held) {
+  held_ = held;
+  if (!held_) flush();
+}
+
+void TcpConnection::flush() {
+  while (!held_ && output_sent_ < output_.size()) {
+    const ssize_t n =
+        ::send(fd_, output_.data() + output_sent_, output_.size() - output_sent_, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n > 0) {
+      output_sent_ += static_cast<size_t>(n);
+    } else if (n < 0 && errno == EINTR) {
+      continue;
+    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      break;
+    } else {
+      close(n < 0 ? std::strerror(errno) : "send failed");
+      return;
+    }
+  }
+  if (output_sent_ == output_.size()) {
+    output_.clear();
+    output_sent_ = 0;
+  } else if (output_sent_ > kCompactOutputBytes) {
+    output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(output_sent_));
+    output_sent_ = 0;
+  }
+  update_events();
+  if (!closing_ && output_.empty()) session_->on_output_drained();
+}
+
+void TcpConnection::update_events() {
+  if (closing_) return;
+  short events = 0;
+  if (session_->read_budget() > 0) events |= POLLIN;
+  if (!held_ && output_sent_ < output_.size()) events |= POLLOUT;
+  server_.loop_.set_events(fd_, events);
+}
+
+void TcpConnection::close(const std::string& reason) {
+  if (closing_) return;
+  closing_ = true;
+  server_.remove(*this, reason);
+}
+
+TcpConnectionServer::OpenResult TcpConnectionServer::open(EventLoop& loop, const TcpEndpointSpec& spec, Config config,
+                                                          SessionFactory factory, LogSink log) {
+  OpenResult result;
+  const int fd = listen_tcp(spec, result.error);
+  if (fd < 0) return result;
+  result.server.reset(new TcpConnectionServer(loop, fd, std::move(config), std::move(factory), std::move(log)));
+  return result;
+}
+
+TcpConnectionServer::TcpConnectionServer(EventLoop& loop, int listen_fd, Config config, SessionFactory factory,
+                                         LogSink log)
+    : loop_(loop), listen_fd_(listen_fd), config_(std::move(config)), factory_(std::move(factory)), log_(std::move(log)) {
+  loop_.watch(listen_fd_, POLLIN, [this](short) { accept_clients(); });
+}
+
+TcpConnectionServer::~TcpConnectionServer() {
+  for (auto& [id, connection] : connections_) {
+    connection->closing_ = true;
+    loop_.unwatch(connection->fd_);
+    connection->session_->on_close();
+  }
+  connections_.clear();
+  loop_.unwatch(listen_fd_);
+  ::close(listen_fd_);
+}
+
+std::string TcpConnectionServer::local_address() const {
+  sockaddr_storage address{};
+  socklen_t length = sizeof(address);
+  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
+  return format_socket_address(address);
+}
+
+uint16_t TcpConnectionServer::local_port() const {
+  sockaddr_storage address{};
+  socklen_t length = sizeof(address);
+  ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
+  if (address.ss_family == AF_INET) return ntohs(reinterpret_cast<const sockaddr_in&>(address).sin_port);
+  return ntohs(reinterpret_cast<const sockaddr_in6&>(address).sin6_port);
+}
+
+TcpConnection* TcpConnectionServer::find(uint64_t id) {
+  const auto found = connections_.find(id);
+  return found == connections_.end() ? nullptr : found->second.get();
+}
+
+void TcpConnectionServer::accept_clients(bool after_other_callbacks) {
+  for (;;) {
+    if (connections_.size() >= config_.max_clients && !after_other_callbacks) {
+      std::weak_ptr<bool> alive = lifetime_;
+      loop_.defer([this, alive] {
+        if (!alive.expired()) accept_clients(true);
+      });
+      return;
+    }
+    sockaddr_storage address{};
+    socklen_t length = sizeof(address);
+    const int fd = ::accept4(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length, SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (fd < 0) {
+      if (errno == EINTR || errno == ECONNABORTED || errno == EPROTO) continue;
+      if (errno == EMFILE || errno == ENFILE || errno == ENOBUFS || errno == ENOMEM) {
+        log_("motwin: cannot accept a " + config_.kind + " client: " + std::string(std::strerror(errno)) +
+             "; retrying shortly");
+        loop_.set_events(listen_fd_, 0);
+        std::weak_ptr<bool> alive = lifetime_;
+        loop_.add_timer_after(kAcceptRetryUs, [this, alive] {
+          if (!alive.expired()) loop_.set_events(listen_fd_, POLLIN);
+        });
+      }
+      return;  // EAGAIN: all accepted
+    }
+    const std::string peer = format_socket_address(address);
+    if (connections_.size() >= config_.max_clients) {
+      log_("motwin: refusing " + config_.kind + " client " + peer + ": already " + std::to_string(config_.max_clients) +
+           " clients");
+      ::close(fd);
+      continue;
+    }
+    const int on = 1;
+    ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));  // small request/reply exchanges: no Nagle delay
+    const uint64_t id = next_connection_id_++;
+    auto connection = std::make_shared<TcpConnection>(*this, id, fd, peer);
+    TcpConnection* raw = connection.get();
+    connections_[id] = std::move(connection);
+    raw->session_ = factory_(*raw);
+    raw->session_->connection_ = raw;
+    loop_.watch(fd, POLLIN, [raw](short revents) { raw->on_events(revents); });
+    log_("motwin: " + config_.kind + " client " + peer + " connected");
+    raw->session_->on_open();
+    raw->update_events();
+  }
+}
+
+void TcpConnectionServer::remove(TcpConnection& connection, const std::string& reason) {
+  loop_.unwatch(connection.fd_);
+  connection.session_->on_close();
+  log_("motwin: " + config_.kind + " client " + connection.peer_ + " disconnected (" + reason + ")");
+  const auto found = connections_.find(connection.id_);
+  if (found == connections_.end()) return;
+  // Its member functions may be on the stack right now: destroy it after this dispatch.
+  std::shared_ptr<TcpConnection> keep_alive = std::move(found->second);
+  connections_.erase(found);
+  loop_.defer([keep_alive] {});
+}
+
+}  // namespace motwin::host
