@@ -247,8 +247,16 @@ def test_pty_frame_flood(motwin):
                     request = frame(GGP, 9, BANK_USER)
 
                     def pty_flood():
+                        # Read while writing, as a serial client does: the server stops reading
+                        # while its replies back up (back-pressure), so a client that writes
+                        # everything before reading anything could block both sides.
+                        received = {}
+                        reader = threading.Thread(
+                            target=lambda: received.update(data=c.read_exact(9 * count, timeout=120.0)), daemon=True)
+                        reader.start()
                         c.send_raw(request * count)
-                        data = c.read_exact(9 * count, timeout=120.0)
+                        reader.join(125.0)
+                        data = received.get("data", b"")
                         replies = [parse_reply(data[i:i + 9]) for i in range(0, len(data), 9)]
                         for r in replies:
                             check((r.status, r.command) == (STATUS_OK, GGP), f"pty flood reply {r.raw.hex(' ')}")

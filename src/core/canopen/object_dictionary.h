@@ -8,8 +8,9 @@
 // per axis, axis n at index + n * axis_stride (0x200 manufacturer area, 0x800 profile area,
 // 0x40 PDO parameters).
 //
-// The SDO server (and later the PDOs and the EDS writer) reach every object through the one
-// ObjectDictionary interface, as CANopenNode's OD interface does.
+// The SDO server and the PDOs reach every object through the one ObjectDictionary interface, as
+// CANopenNode's OD interface does. A TableDictionary finds an index/sub-index by binary search in
+// an index of its rows that its constructor sorts once (fixed capacity, no heap).
 #pragma once
 
 #include <cstddef>
@@ -108,6 +109,17 @@ class ObjectDictionary {
   // A write as an SDO download makes it: access, size (kDataTooLong/kDataTooShort), range
   // (kValueTooHigh/kValueTooLow) and the object's own checks, then the value is stored.
   virtual SdoAbort write(const ObjectRef& ref, const uint8_t* data, size_t length) = 0;
+  // Part of a value longer than the SDO server's buffer (a large DOMAIN), `capacity` bytes
+  // from `offset` on (fewer at the end), so that uploads of any size stream through a fixed
+  // buffer. Objects that fit the buffer never get here; the default refuses (05040005).
+  virtual SdoAbort read_part(const ObjectRef& ref, size_t offset, uint8_t* out, size_t capacity, size_t& length) {
+    (void)ref;
+    (void)offset;
+    (void)out;
+    (void)capacity;
+    length = 0;
+    return SdoAbort::kOutOfMemory;
+  }
 
  protected:
   ~ObjectDictionary() = default;
@@ -158,8 +170,15 @@ constexpr EntryBinding<Owner> field_binding() {
 template <class Owner>
 class TableDictionary final : public ObjectDictionary {
  public:
+  // Rows the lookup index holds, and distinct axis strides it handles. A table beyond either is
+  // searched row by row: the same answers, only slower (indexed() says which).
+  static constexpr size_t kIndexCapacity = 512;
+  static constexpr size_t kMaxStrides = 4;
+
   TableDictionary(Owner& owner, std::span<const EntryRow<Owner>> rows, uint8_t axis_count)
-      : owner_(owner), rows_(rows), axis_count_(axis_count) {}
+      : owner_(owner), rows_(rows), axis_count_(axis_count) {
+    build_index();
+  }
   TableDictionary(const TableDictionary&) = delete;
   TableDictionary& operator=(const TableDictionary&) = delete;
 
@@ -174,7 +193,27 @@ class TableDictionary final : public ObjectDictionary {
     return info.default_plus_node_id ? base + node_id_ : base;
   }
 
+  // The first row in table order that is `index`/`sub` for some axis. By binary search over the
+  // rows sorted by base index: an object of axis n has its row n strides below `index`, so the
+  // candidates are the rows at `index` itself and at `index - n * stride` for each distinct
+  // stride of the table; each candidate is then matched exactly as find_linear() matches it.
   SdoAbort find(uint16_t index, uint8_t sub, ObjectRef& out) const override {
+    if (!indexed_) return find_linear(index, sub, out);
+    Match match;
+    match_base(index, index, sub, match);
+    for (size_t s = 0; s < stride_count_; ++s) {
+      for (uint32_t n = 1; n < axis_count_; ++n) {
+        const uint32_t below = n * strides_[s];
+        if (below <= index) match_base(static_cast<uint16_t>(index - below), index, sub, match);
+      }
+    }
+    if (match.row == kNoRow) return match.index_found ? SdoAbort::kNoSubIndex : SdoAbort::kNoObject;
+    out = ObjectRef{&rows_[match.row].info, match.row, index, match.axis};
+    return SdoAbort::kNone;
+  }
+  // Every row in table order: what find() answers without the index (tables beyond its capacity,
+  // and the reference the tests hold find() to).
+  SdoAbort find_linear(uint16_t index, uint8_t sub, ObjectRef& out) const {
     bool index_found = false;
     for (size_t i = 0; i < rows_.size(); ++i) {
       uint8_t axis = 0;
@@ -186,6 +225,8 @@ class TableDictionary final : public ObjectDictionary {
     }
     return index_found ? SdoAbort::kNoSubIndex : SdoAbort::kNoObject;
   }
+  // Whether find() uses the sorted index (false: the table exceeds kIndexCapacity or kMaxStrides).
+  bool indexed() const { return indexed_; }
 
   size_t size(const ObjectRef& ref) override {
     if (is_numeric(ref.info->type)) return type_size(ref.info->type);
@@ -244,10 +285,77 @@ class TableDictionary final : public ObjectDictionary {
   uint8_t axes_of(const EntryInfo& info) const { return info.axis_stride == 0 ? 1 : axis_count_; }
 
  private:
+  static constexpr size_t kNoRow = ~size_t{0};
+  struct Match {
+    size_t row = kNoRow;  // the lowest matching row so far
+    uint8_t axis = 0;
+    bool index_found = false;
+  };
+
+  // Sorts the row numbers by (base index, sub-index, row) once; rows_ never changes afterwards.
+  void build_index() {
+    if (rows_.size() > kIndexCapacity) return;
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      const uint16_t stride = rows_[i].info.axis_stride;
+      if (stride == 0) continue;
+      bool known = false;
+      for (size_t s = 0; s < stride_count_; ++s) known = known || strides_[s] == stride;
+      if (known) continue;
+      if (stride_count_ == kMaxStrides) return;
+      strides_[stride_count_++] = stride;
+    }
+    // Insertion sort: a few hundred rows, once, at start-up.
+    for (size_t i = 0; i < rows_.size(); ++i) {
+      size_t k = i;
+      while (k > 0 && sorts_before(i, order_[k - 1])) {
+        order_[k] = order_[k - 1];
+        --k;
+      }
+      order_[k] = static_cast<uint16_t>(i);
+    }
+    indexed_ = true;
+  }
+  bool sorts_before(size_t a, size_t b) const {
+    const EntryInfo& x = rows_[a].info;
+    const EntryInfo& y = rows_[b].info;
+    if (x.index != y.index) return x.index < y.index;
+    if (x.sub != y.sub) return x.sub < y.sub;
+    return a < b;
+  }
+  // The rows whose base index is `base`, matched against the asked-for `index` and `sub`.
+  void match_base(uint16_t base, uint16_t index, uint8_t sub, Match& match) const {
+    size_t low = 0;
+    size_t high = rows_.size();
+    while (low < high) {  // first sorted position with a base index >= base
+      const size_t mid = low + (high - low) / 2;
+      if (rows_[order_[mid]].info.index < base) {
+        low = mid + 1;
+      } else {
+        high = mid;
+      }
+    }
+    for (size_t k = low; k < rows_.size() && rows_[order_[k]].info.index == base; ++k) {
+      const size_t row = order_[k];
+      uint8_t axis = 0;
+      if (!index_matches(rows_[row].info, index, axis_count_, axis)) continue;
+      match.index_found = true;
+      if (rows_[row].info.sub == sub && row < match.row) {
+        match.row = row;
+        match.axis = axis;
+      }
+    }
+  }
+
   Owner& owner_;
   std::span<const EntryRow<Owner>> rows_;
   uint8_t axis_count_;
   uint8_t node_id_ = 1;
+  // The lookup index, built by the constructor (no heap): row numbers sorted by base index and
+  // the table's distinct non-zero axis strides.
+  uint16_t order_[kIndexCapacity] = {};
+  uint16_t strides_[kMaxStrides] = {};
+  size_t stride_count_ = 0;
+  bool indexed_ = false;
 };
 
 }  // namespace motwin::canopen

@@ -2,7 +2,11 @@
 // sub-blocks of up to 127 segments, each segment `last << 7 | seqno` followed by 7 data bytes,
 // acknowledged per sub-block with the last sequence number received in order. Both directions
 // end with the number of unused bytes of the last segment and, when both sides support it, the
-// CRC of the data. The whole value passes through buffer_, as in the segmented transfer.
+// CRC of the data. A download passes whole through buffer_; an upload longer than buffer_ streams
+// through it in windows that each hold at least one whole sub-block, so that a sub-block can be
+// sent again after a partial acknowledgement.
+#include <array>
+
 #include "core/canopen/sdo_server.h"
 
 namespace motwin::canopen {
@@ -31,14 +35,26 @@ uint32_t le32(const uint8_t* p) {
          static_cast<uint32_t>(p[3]) << 24;
 }
 
+// CRC-16/CCITT one byte at a time: entry b is the CRC register after shifting b through the
+// polynomial 0x1021 bit by bit (512 bytes of flash instead of 8 shifts per byte).
+constexpr std::array<uint16_t, 256> make_crc16_table() {
+  std::array<uint16_t, 256> table{};
+  for (unsigned byte = 0; byte < 256; ++byte) {
+    auto crc = static_cast<uint16_t>(byte << 8);
+    for (int bit = 0; bit < 8; ++bit) {
+      crc = (crc & 0x8000) != 0 ? static_cast<uint16_t>((crc << 1) ^ 0x1021) : static_cast<uint16_t>(crc << 1);
+    }
+    table[byte] = crc;
+  }
+  return table;
+}
+constexpr std::array<uint16_t, 256> kCrc16Table = make_crc16_table();
+
 }  // namespace
 
 uint16_t crc16_ccitt(const uint8_t* data, size_t length, uint16_t crc) {
   for (size_t i = 0; i < length; ++i) {
-    crc = static_cast<uint16_t>(crc ^ (static_cast<uint16_t>(data[i]) << 8));
-    for (int bit = 0; bit < 8; ++bit) {
-      crc = (crc & 0x8000) != 0 ? static_cast<uint16_t>((crc << 1) ^ 0x1021) : static_cast<uint16_t>(crc << 1);
-    }
+    crc = static_cast<uint16_t>((crc << 8) ^ kCrc16Table[((crc >> 8) ^ data[i]) & 0xFF]);
   }
   return crc;
 }
@@ -159,7 +175,7 @@ void SdoServer::initiate_block_upload(const uint8_t* data) {
     return;
   }
   size_t length = 0;
-  if (const SdoAbort read = dictionary_.read(object_, buffer_, kBufferSize, length); read != SdoAbort::kNone) {
+  if (const SdoAbort read = load_upload(length); read != SdoAbort::kNone) {
     abort(index_, sub_, read);
     return;
   }
@@ -175,6 +191,7 @@ void SdoServer::initiate_block_upload(const uint8_t* data) {
   block_crc_ = (data[0] & kCrcSupported) != 0;
   block_size_ = requested_block_size;
   block_sequence_ = 0;
+  upload_crc_ = 0;
   state_ = SdoState::kUploadBlockStart;
   const uint8_t response[8] = {kUploadInitiateResponse,
                                data[1],
@@ -204,9 +221,12 @@ void SdoServer::upload_block_request(const uint8_t* data) {
       abort(index_, sub_, SdoAbort::kInvalidBlockSize);
       return;
     }
-    // Segments after `acknowledged` are sent again in the next sub-block.
-    offset_ += static_cast<size_t>(acknowledged) * kSegmentData;
-    if (offset_ > size_) offset_ = size_;
+    // Segments after `acknowledged` are sent again in the next sub-block. The acknowledged
+    // bytes are still in the window (it holds the whole sub-block just sent).
+    size_t advanced = static_cast<size_t>(acknowledged) * kSegmentData;
+    if (advanced > size_ - offset_) advanced = size_ - offset_;
+    if (block_crc_) upload_crc_ = crc16_ccitt(window_data(offset_), advanced, upload_crc_);
+    offset_ += advanced;
     block_size_ = next_block_size;
     const bool all_acknowledged = acknowledged == block_sequence_ && offset_ == size_;
     if (!all_acknowledged) {
@@ -214,7 +234,7 @@ void SdoServer::upload_block_request(const uint8_t* data) {
       return;
     }
     const size_t in_last = size_ % kSegmentData == 0 && size_ > 0 ? kSegmentData : size_ % kSegmentData;
-    const uint16_t crc = block_crc_ ? crc16_ccitt(buffer_, size_) : 0;
+    const uint16_t crc = block_crc_ ? upload_crc_ : 0;
     const uint8_t end[8] = {static_cast<uint8_t>(kUploadEndRequest | ((kSegmentData - in_last) << 2)),
                             static_cast<uint8_t>(crc),
                             static_cast<uint8_t>(crc >> 8),
@@ -236,6 +256,12 @@ void SdoServer::upload_block_request(const uint8_t* data) {
 
 void SdoServer::send_upload_sub_block() {
   // Segments from offset_ on, at most block_size_ of them; an empty object is one empty last segment.
+  if (const SdoAbort read = cover(offset_, static_cast<size_t>(block_size_) * kSegmentData);
+      read != SdoAbort::kNone) {
+    abort(index_, sub_, read);
+    return;
+  }
+  const uint8_t* bytes = window_data(offset_);
   uint8_t sequence = 0;
   size_t position = offset_;
   do {
@@ -244,7 +270,7 @@ void SdoServer::send_upload_sub_block() {
     ++sequence;
     const bool last = position + length == size_;
     uint8_t segment[8] = {static_cast<uint8_t>(sequence | (last ? kLastSegment : 0)), 0, 0, 0, 0, 0, 0, 0};
-    for (size_t i = 0; i < length; ++i) segment[1 + i] = buffer_[position + i];
+    for (size_t i = 0; i < length; ++i) segment[1 + i] = bytes[position - offset_ + i];
     position += length;
     respond(segment);
     if (last) break;

@@ -198,7 +198,7 @@ void SdoServer::initiate_upload(const uint8_t* data) {
     return;
   }
   size_t length = 0;
-  if (const SdoAbort read = dictionary_.read(object_, buffer_, kBufferSize, length); read != SdoAbort::kNone) {
+  if (const SdoAbort read = load_upload(length); read != SdoAbort::kNone) {
     abort(index_, sub_, read);
     return;
   }
@@ -231,13 +231,50 @@ void SdoServer::upload_segment(const uint8_t* data) {
   }
   const size_t remaining = size_ - offset_;
   const size_t length = remaining < 7 ? remaining : 7;
+  if (const SdoAbort read = cover(offset_, length); read != SdoAbort::kNone) {
+    abort(index_, sub_, read);
+    return;
+  }
   const bool last = offset_ + length == size_;
   uint8_t response[8] = {static_cast<uint8_t>(toggle_ | ((7 - length) << 1) | (last ? 1 : 0)), 0, 0, 0, 0, 0, 0, 0};
-  for (size_t i = 0; i < length; ++i) response[1 + i] = buffer_[offset_ + i];
+  const uint8_t* bytes = window_data(offset_);
+  for (size_t i = 0; i < length; ++i) response[1 + i] = bytes[i];
   offset_ += length;
   toggle_ ^= kToggleBit;
   if (last) state_ = SdoState::kIdle;
   respond(response);
+}
+
+SdoAbort SdoServer::load_upload(size_t& total) {
+  total = dictionary_.size(object_);
+  window_start_ = 0;
+  window_length_ = 0;
+  streaming_ = total > kBufferSize;
+  if (streaming_) {
+    size_ = total;  // cover() clips to it
+    return cover(0, kBufferSize);
+  }
+  size_t length = 0;
+  const SdoAbort read = dictionary_.read(object_, buffer_, kBufferSize, length);
+  if (read != SdoAbort::kNone) return read;
+  total = length;
+  window_length_ = length;
+  return SdoAbort::kNone;
+}
+
+SdoAbort SdoServer::cover(size_t position, size_t length) {
+  if (position + length > size_) length = size_ - position;
+  if (position >= window_start_ && position + length <= window_start_ + window_length_) return SdoAbort::kNone;
+  if (!streaming_) return SdoAbort::kGeneral;  // cannot happen: a buffered value is whole
+  const size_t wanted = size_ - position < kBufferSize ? size_ - position : kBufferSize;
+  size_t read_length = 0;
+  const SdoAbort read = dictionary_.read_part(object_, position, buffer_, wanted, read_length);
+  if (read != SdoAbort::kNone) return read;
+  // A value that shrank under the transfer cannot deliver the announced size.
+  if (read_length < length) return SdoAbort::kGeneral;
+  window_start_ = position;
+  window_length_ = read_length;
+  return SdoAbort::kNone;
 }
 
 void SdoServer::abort(uint16_t index, uint8_t sub, SdoAbort abort_code) {

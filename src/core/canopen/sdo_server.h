@@ -53,8 +53,9 @@ class SdoServer {
  public:
   // CANopenNode's default server timeout; python-canopen's client waits 0.3 s per response.
   static constexpr uint32_t kTimeoutUs = 1'000'000;
-  // Largest value a segmented or block transfer carries. The TMCM-3216's longest object is a
-  // short visible string; the room is for larger (test) objects and whole block transfers.
+  // Largest value a segmented or block download carries, and the window through which longer
+  // values stream on upload (ObjectDictionary::read_part). The TMCM-3216's longest object is a
+  // short visible string; the room is for larger objects and whole sub-blocks (127 x 7 bytes).
   static constexpr size_t kBufferSize = 1024;
   // Segments per sub-block the server asks for in a block download (CiA-301 maximum).
   static constexpr uint8_t kMaxBlockSize = 127;
@@ -89,6 +90,13 @@ class SdoServer {
   void initiate_block_upload(const uint8_t* data);
   void upload_block_request(const uint8_t* data);
   void send_upload_sub_block();
+  // Upload of size_ bytes: buffer_ holds bytes [window_start_, window_start_ + window_length_).
+  // Loads the value (whole, or its first window when it is longer than the buffer).
+  SdoAbort load_upload(size_t& total);
+  // Makes the window cover [position, position + length) (clipped to size_), reading from
+  // `position` on when it does not; the bytes at `position` are then at window_data(position).
+  SdoAbort cover(size_t position, size_t length);
+  const uint8_t* window_data(size_t position) const { return buffer_ + (position - window_start_); }
   void abort(uint16_t index, uint8_t sub, SdoAbort code);
   void respond(const uint8_t (&data)[8]);
 
@@ -111,6 +119,10 @@ class SdoServer {
   size_t size_ = 0;          // announced (download) or total (upload) size
   size_t offset_ = 0;        // bytes received or sent so far
   uint8_t buffer_[kBufferSize] = {};
+  size_t window_start_ = 0;
+  size_t window_length_ = 0;
+  bool streaming_ = false;   // the upload is longer than buffer_ and read in windows
+  uint16_t upload_crc_ = 0;  // block upload: CRC of the bytes acknowledged so far
   // Block transfer: whether both sides use the CRC, segments per sub-block, the last sequence
   // number received in order (download) or sent (upload).
   bool block_crc_ = false;

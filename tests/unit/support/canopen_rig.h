@@ -11,32 +11,13 @@
 #include <vector>
 
 #include "board/can_controller.h"
+#include "sdo_frames.h"
 #include "board/ram_non_volatile_memory.h"
 #include "core/can/can_frame.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 
 namespace motwin::testing {
 
-class RecordingCanController final : public board::CanController {
- public:
-  std::vector<can::CanFrame> frames;
-  bool transmit(const can::CanFrame& frame) override {
-    frames.push_back(frame);
-    return true;
-  }
-  std::vector<can::CanFrame> take() {
-    std::vector<can::CanFrame> out;
-    out.swap(frames);
-    return out;
-  }
-};
-
-inline can::CanFrame frame_of(uint32_t id, std::initializer_list<uint8_t> bytes) {
-  can::CanFrame frame;
-  frame.id = id;
-  for (uint8_t b : bytes) frame.data[frame.dlc++] = b;
-  return frame;
-}
 
 inline uint32_t le32(const can::CanFrame& frame, size_t offset) {
   return static_cast<uint32_t>(frame.data[offset]) | static_cast<uint32_t>(frame.data[offset + 1]) << 8 |
