@@ -52,10 +52,7 @@ BitString stuffed_region(const can::CanFrame& frame) {
   return bits;
 }
 
-}  // namespace
-
-uint32_t can_stuff_bits(const can::CanFrame& frame) {
-  const BitString bits = stuffed_region(frame);
+uint32_t stuff_bits_of(const BitString& bits) {
   uint32_t stuffed = 0;
   uint32_t run = 0;
   uint8_t last = 2;
@@ -76,8 +73,14 @@ uint32_t can_stuff_bits(const can::CanFrame& frame) {
   return stuffed;
 }
 
+}  // namespace
+
+uint32_t can_stuff_bits(const can::CanFrame& frame) { return stuff_bits_of(stuffed_region(frame)); }
+
 uint32_t can_frame_bits(const can::CanFrame& frame) {
-  return stuffed_region(frame).length + can_stuff_bits(frame) + kTrailerBits;
+  // Built once: the bus asks for every frame it carries.
+  const BitString bits = stuffed_region(frame);
+  return bits.length + stuff_bits_of(bits) + kTrailerBits;
 }
 
 }  // namespace motwin::host

@@ -37,6 +37,11 @@ class TmclCanNode final : public CanBusNode, public tmcl::ReplySink {
   void connect(CanBus& bus) override;
   void disconnect() override;
   void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override;
+  // The bus cuts the node off while this differs from its rate (host/can_bus.h).
+  uint32_t controller_bit_rate() override {
+    follow_power_up();
+    return active_bit_rate_;
+  }
 
   // tmcl::ReplySink: a command 138 reply for a CAN host.
   void deliver(tmcl::ChannelId channel, const tmcl::Reply& reply) override;
@@ -49,7 +54,7 @@ class TmclCanNode final : public CanBusNode, public tmcl::ReplySink {
   uint64_t served_requests() const { return served_requests_; }
   // Bit/s the controller was set up with at the last power-up (GP 69).
   uint32_t active_bit_rate() const { return active_bit_rate_; }
-  // false: its bit rate does not match the bus's, the node is cut off.
+  // false: its bit rate does not match the bus's (or its controller is bus-off), the node is cut off.
   bool on_speed() const;
   // Current IDs and bit rate (GP 70, 71, 69).
   tmcl::CanSettings settings() const;

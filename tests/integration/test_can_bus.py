@@ -59,7 +59,7 @@ def test_several_modules_on_one_bus(motwin):
                                          is_extended_id=False))
                     answers = collect(bus, 0.3, lambda m: 0x580 <= m.arbitration_id < 0x600 or m.arbitration_id == 2)
                     check_equal([m.arbitration_id for m in answers], [0x580 + node], f"answers to node {node}'s SDO")
-                    check_equal(struct.unpack_from("<I", bytes(answers[0].data), 4)[0], 0xFFFC0192, "1000")
+                    check_equal(struct.unpack_from("<I", bytes(answers[0].data), 4)[0], 0xFFFF0192, "1000")
                 # 1018 sub 4 and the TMCL module beside them.
                 tmcl = TmclCan(bus)
                 tmcl.send_raw([136, 1, 0, 0, 0, 0, 0])
@@ -102,7 +102,7 @@ def test_candump_prints_the_bus(motwin):
             try:
                 client.send(0x123, [0xDE, 0xAD])
                 client.send(0x7FF, [])
-                check_equal(client.upload_u(4, 0x1000, 0), 0xFFFC0192, "SDO while candump listens")
+                check_equal(client.upload_u(4, 0x1000, 0), 0xFFFF0192, "SDO while candump listens")
             finally:
                 client.close()
             out, err = dump.communicate(timeout=10)
@@ -117,7 +117,7 @@ def test_candump_prints_the_bus(motwin):
             m = pattern.fullmatch(line)
             check(m is not None, f"candump line {line!r}")
             parsed.append((m.group(3), m.group(4)))
-        check_equal(parsed, [("123", "DEAD"), ("7FF", ""), ("604", "4000100000000000"), ("584", "430010009201FCFF")],
+        check_equal(parsed, [("123", "DEAD"), ("7FF", ""), ("604", "4000100000000000"), ("584", "430010009201FFFF")],
                     "candump frames")
         stamps = [float(line[1:line.index(")")]) for line in lines]
         check(stamps == sorted(stamps), f"timestamps in order: {stamps}")
@@ -185,37 +185,49 @@ def test_tshark_decodes_a_capture_as_canopen(motwin):
 
 
 def test_bus_load_and_a_flood(motwin):
-    with TempDir() as tmp, BusServer(motwin, os.path.join(tmp, "state"),
-                                     ["--module", "tmcm-3216", "--node-id", "3", "--can", "socketcand:127.0.0.1:0",
-                                      "--can-bitrate", "125k", "--can-stats", "0.3"]) as server:
-        flood = RawSocketcand(server.port())
-        try:
-            for expected in ("< hi >",):
-                check_equal(flood.read_element(), expected, "greeting")
-            flood.send("< open can0 >< rawmode >")
-            # 3000 frames at once: far beyond what 125 kbit/s carries in the moment they arrive.
-            flood.send("".join(f"< send 7{i % 16:X}0 8 1 2 3 4 5 6 7 8 >" for i in range(3000)))
+    with TempDir() as tmp:
+        state = os.path.join(tmp, "state")
+        # The node must run at the bus's 125 kbit/s (a node at another rate is cut off,
+        # test_can_bitrate.py): 2704 = 125 stored first, on a 1 Mbit/s bus.
+        with BusServer(motwin, state, ["--module", "tmcm-3216", "--node-id", "3",
+                                       "--can", "socketcand:127.0.0.1:0"]) as server:
             client = CanopenClient(server.port())
             try:
-                check_equal(client.upload_u(3, 0x1000, 0), 0xFFFC0192, "SDO during the flood")
+                client.download(3, 0x2704, 0, 125, 2)
+                client.download(3, 0x2706, 1, 0x65766173, 4)  # "save"
             finally:
                 client.close()
-        finally:
-            flood.close()
-        deadline = time.monotonic() + 5
-        while time.monotonic() < deadline and not any(l.startswith("can-stats") and "(+0)" not in l
-                                                      for l in server.stdout_lines):
-            time.sleep(0.05)
-        stats = [l for l in server.stdout_lines if l.startswith("can-stats")]
-        check(stats, f"can-stats lines: {server.stdout_lines!r}")
-        m = re.match(r"can-stats frames (\d+) \(\+(\d+)\) bits (\d+) load ([\d.]+)% queue-delay mean ([\d.]+) ms "
-                     r"max ([\d.]+) ms bitrate (\d+)", [l for l in stats if "(+0)" not in l][0])
-        check(m is not None, f"can-stats format: {stats!r}")
-        check(int(m.group(1)) >= 3000, f"frames counted: {stats!r}")
-        check_equal(int(m.group(7)), 125000, "bit rate in can-stats")
-        # 3000 frames of ~130 bits at 125 kbit/s are ~3 s of bus time: a long queue.
-        check(float(m.group(6)) > 1000.0, f"max queueing delay shows the overload: {stats!r}")
-        server.stop()
+            server.stop()
+        with BusServer(motwin, state, ["--module", "tmcm-3216", "--node-id", "3", "--can", "socketcand:127.0.0.1:0",
+                                       "--can-bitrate", "125k", "--can-stats", "0.3"]) as server:
+            flood = RawSocketcand(server.port())
+            try:
+                for expected in ("< hi >",):
+                    check_equal(flood.read_element(), expected, "greeting")
+                flood.send("< open can0 >< rawmode >")
+                # 3000 frames at once: far beyond what 125 kbit/s carries in the moment they arrive.
+                flood.send("".join(f"< send 7{i % 16:X}0 8 1 2 3 4 5 6 7 8 >" for i in range(3000)))
+                client = CanopenClient(server.port())
+                try:
+                    check_equal(client.upload_u(3, 0x1000, 0), 0xFFFF0192, "SDO during the flood")
+                finally:
+                    client.close()
+            finally:
+                flood.close()
+            deadline = time.monotonic() + 5
+            while time.monotonic() < deadline and not any(l.startswith("can-stats") and "(+0)" not in l
+                                                          for l in server.stdout_lines):
+                time.sleep(0.05)
+            stats = [l for l in server.stdout_lines if l.startswith("can-stats")]
+            check(stats, f"can-stats lines: {server.stdout_lines!r}")
+            m = re.match(r"can-stats frames (\d+) \(\+(\d+)\) bits (\d+) load ([\d.]+)% queue-delay mean ([\d.]+) ms "
+                         r"max ([\d.]+) ms bitrate (\d+)", [l for l in stats if "(+0)" not in l][0])
+            check(m is not None, f"can-stats format: {stats!r}")
+            check(int(m.group(1)) >= 3000, f"frames counted: {stats!r}")
+            check_equal(int(m.group(7)), 125000, "bit rate in can-stats")
+            # 3000 frames of ~130 bits at 125 kbit/s are ~3 s of bus time: a long queue.
+            check(float(m.group(6)) > 1000.0, f"max queueing delay shows the overload: {stats!r}")
+            server.stop()
 
 
 def test_malformed_input_and_clients_leaving_mid_transfer(motwin):
@@ -255,7 +267,7 @@ def test_malformed_input_and_clients_leaving_mid_transfer(motwin):
         try:
             # The stale transfer is replaced by a new initiate; the node keeps serving.
             check_equal(client.upload(6, 0x1008, 0), b"TMCM-3216", "segmented upload after the abandoned one")
-            check_equal(client.upload_u(6, 0x1000, 0), 0xFFFC0192, "expedited upload")
+            check_equal(client.upload_u(6, 0x1000, 0), 0xFFFF0192, "expedited upload")
         finally:
             client.close()
         server.stop()
@@ -288,7 +300,7 @@ def test_socketcan_endpoint(motwin):
             import can
             bus = can.Bus(interface="socketcan", channel="vcan0")
             try:
-                check_equal(sdo_upload_u32(bus, 8, 0x1000, 0), 0xFFFC0192, "SDO over vcan0")
+                check_equal(sdo_upload_u32(bus, 8, 0x1000, 0), 0xFFFF0192, "SDO over vcan0")
             finally:
                 bus.shutdown()
             live.stop()

@@ -30,11 +30,15 @@ def pdo_frames(frames, cob_id):
     return [m for m in frames if m.arbitration_id == cob_id]
 
 
-def test_default_pdos_are_silent_until_mapped(motwin):
+def test_default_pdos_of_axis_0(motwin):
+    # Tables 45/47: TPDO 1 (6041) and TPDO 2 (6041, 6061) are event driven and go out once on
+    # entering operational; TPDO 3/4 are synchronous; the PDOs of axes 1 and 2 start disabled.
     with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
         bus.nmt(NMT_START, NODE)
         frames = bus.collect(0.3, lambda m: 0x180 <= m.arbitration_id < 0x580)
-        check_equal(frames, [], "PDOs with the CiA-402 default mappings (objects not there yet)")
+        check_equal([(m.arbitration_id, bytes(m.data)) for m in frames],
+                    [(0x180 + NODE, bytes([0x40, 0x02])), (0x280 + NODE, bytes([0x40, 0x02, 0x00]))],
+                    "TPDO 1 and 2 of axis 0 (switch on disabled, mode 0)")
         server.stop()
 
 
@@ -66,7 +70,7 @@ def test_mapping_refusals(motwin):
         bus.download(NODE, 0x1801, 1, 0x80000280 + NODE, 4)
         bus.download(NODE, 0x1A01, 0, 0, 1)
         check_equal(bus.abort_code(bus.download, NODE, 0x1A01, 1, 0x10000020, 4), 0x06040041, "1000 not mappable")
-        check_equal(bus.abort_code(bus.download, NODE, 0x1A01, 1, 0x60410010, 4), 0x06040041, "6041 absent")
+        check_equal(bus.abort_code(bus.download, NODE, 0x1A01, 1, 0x60430010, 4), 0x06040041, "6043 absent")
         for sub, entry in ((1, DUMMY_U32), (2, DUMMY_U32), (3, DUMMY_U8)):
             bus.download(NODE, 0x1A01, sub, entry, 4)
         check_equal(bus.abort_code(bus.download, NODE, 0x1A01, 0, 3, 1), 0x06040042, "72 bits")
@@ -122,7 +126,7 @@ def main():
     except ImportError:
         raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
     run_tests([
-        test_default_pdos_are_silent_until_mapped,
+        test_default_pdos_of_axis_0,
         test_reconfiguration_in_python_canopen_order_and_event_timer,
         test_mapping_refusals,
         test_rpdo_length_errors_send_emcy,

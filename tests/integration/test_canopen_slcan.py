@@ -2,12 +2,16 @@
 """SLCAN over TCP (`--can slcan-tcp:127.0.0.1:0`) with Debian's python3-can (`interface='slcan'`,
 channel `socket://127.0.0.1:PORT`, the pyserial URL): NMT reset and boot-up, SDO expedited and
 segmented, heartbeat, and one bus shared with a socketcand client (each sees the other's frames,
-neither sees its own). Plus the adapter protocol by hand: version, status, errors for frames while
-closed, bit rate change refused while open, garbage lines answered with BEL.
+neither sees its own). The rest of the checklist of notes/canopen.md over SLCAN too: PDO
+reconfiguration in python-canopen's order, SYNC-driven and event-timer TPDOs, RPDO length EMCYs,
+NMT transitions, store/restore across a restart, LSS configure, store and fastscan. Plus the
+adapter protocol by hand: version, status, errors for frames while closed, bit rate change
+refused while open, garbage lines answered with BEL.
 """
 
 import os
 import socket
+import struct
 import sys
 import time
 
@@ -15,7 +19,8 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    NMT_RESET_NODE, STATE_BOOTUP, STATE_PREOP, CanServer, TestFailure, check, check_equal,
+    LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
+    STATE_PREOP, STATE_STOPPED, CanServer, TestFailure, check, check_equal,
 )
 from motwin_harness import TempDir, run_tests  # noqa: E402
 
@@ -31,7 +36,7 @@ def test_slcan_sdo_and_nmt(motwin):
     with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
         bus.nmt(NMT_RESET_NODE, NODE)
         bus.wait_state(NODE, STATE_BOOTUP)
-        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 over SLCAN")
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 over SLCAN")
         check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "1008 over SLCAN (segmented)")
         bus.download(NODE, 0x1017, 0, 50, 2)
         beats = bus.collect(0.5, lambda m: m.arbitration_id == 0x700 + NODE)
@@ -51,6 +56,155 @@ def test_slcan_and_socketcand_share_the_bus(motwin):
         check_equal(bytes(msg.data), b"\x01", "data")
         check_equal(slcan.collect(0.3, lambda m: m.arbitration_id == 0x321), [], "own frame echoed over SLCAN")
         server.stop()
+
+
+DUMMY_U8, DUMMY_U16 = 0x00050008, 0x00060010
+
+
+def sync_and_collect(bus, count, cob_id):
+    """Sends `count` SYNCs; returns the SYNC numbers (1-based) after which the TPDO came."""
+    answered = []
+    for n in range(1, count + 1):
+        bus.send(0x080, [])
+        if bus.collect(0.05, lambda m: m.arbitration_id == cob_id):
+            answered.append(n)
+    return answered
+
+
+def test_slcan_pdo_sync_and_emcy(motwin):
+    """PDO reconfiguration in python-canopen's order, a SYNC-driven TPDO, an event-timer TPDO and
+    the RPDO length EMCYs, all through the SLCAN adapter (python-can stamps SLCAN frames with wall
+    time, so counts are checked, not gaps)."""
+    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
+        tpdo1, tpdo2, rpdo1, emcy = 0x180 + NODE, 0x280 + NODE, 0x200 + NODE, 0x80 + NODE
+        bus.configure_pdo(NODE, 0x1800, tpdo1, 3, [DUMMY_U16])
+        bus.configure_pdo(NODE, 0x1801, tpdo2, 0xFF, [DUMMY_U8], event_ms=100)
+        bus.configure_pdo(NODE, 0x1400, rpdo1, 0xFF, [DUMMY_U16, DUMMY_U8])
+        check_equal([bus.upload_u(NODE, 0x1A00, sub) for sub in (0, 1)], [1, DUMMY_U16], "1A00 read back")
+        check_equal(bus.upload_u(NODE, 0x1800, 2), 3, "1800 sub 2 read back")
+        check_equal(bus.upload_u(NODE, 0x1801, 5), 100, "1801 sub 5 read back")
+        check_equal(sync_and_collect(bus, 3, tpdo1), [], "TPDOs at SYNCs in pre-operational")
+        bus.nmt(NMT_START, NODE)
+        frames = bus.collect(0.55, lambda m: m.arbitration_id == tpdo2)
+        check(4 <= len(frames) <= 7, f"{len(frames)} event-timer TPDOs in 0.55 s at 100 ms")
+        check(all(bytes(m.data) == b"\0" for m in frames), "TPDO 2 data (one dummy byte)")
+        check_equal(sync_and_collect(bus, 9, tpdo1), [3, 6, 9], "type 3: every third SYNC")
+        bus.send(rpdo1, [1, 2])
+        msg = bus.receive(lambda m: m.arbitration_id == emcy, 1.0, "EMCY 8210")
+        check_equal(bytes(msg.data), bytes([0x10, 0x82, 0x11, 0x00, 0xFF, 0, 0, 0]), "EMCY 8210 (RPDO too short)")
+        bus.send(rpdo1, [1, 2, 3])
+        msg = bus.receive(lambda m: m.arbitration_id == emcy, 1.0, "EMCY 0000")
+        check_equal(bytes(msg.data), bytes([0, 0, 0, 0, 0xFF, 0, 0, 0]), "EMCY 0000 (error reset)")
+        bus.nmt(NMT_STOP, NODE)
+        bus.drain(0.05)
+        check_equal(sync_and_collect(bus, 3, tpdo1), [], "TPDOs at SYNCs while stopped")
+        server.stop()
+
+
+def test_slcan_nmt_transitions(motwin):
+    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
+        bus.download(NODE, 0x1017, 0, 1000, 2)  # state changes show as extra heartbeats at once
+        bus.wait_state(NODE, STATE_PREOP)
+        bus.nmt(NMT_START, NODE)
+        bus.wait_state(NODE, STATE_OPERATIONAL, timeout=0.5)
+        bus.nmt(NMT_STOP, 0)
+        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)
+        bus.send(0x600 + NODE, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
+        check_equal(bus.collect(0.3, lambda m: m.arbitration_id == 0x580 + NODE), [], "SDO answers while stopped")
+        bus.nmt(NMT_PREOP, NODE)
+        bus.wait_state(NODE, STATE_PREOP, timeout=0.5)
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "SDO in pre-operational again")
+        bus.nmt(NMT_RESET_COMM, NODE)
+        bus.wait_state(NODE, STATE_BOOTUP)
+        check_equal(bus.upload_u(NODE, 0x1017, 0), 0, "1017 after reset communication")
+        server.stop()
+
+
+def test_slcan_store_and_restore_across_restart(motwin):
+    with TempDir() as tmp:
+        with serve(tmp) as server, server.slcan_bus() as bus:
+            bus.download(NODE, 0x1017, 0, 250, 2)
+            bus.configure_pdo(NODE, 0x1802, 0x380 + NODE, 7, [DUMMY_U8])
+            bus.download(NODE, 0x1010, 1, SAVE, 4)
+            bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
+            server.stop()
+        with serve(tmp) as server, server.slcan_bus() as bus:
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
+            check_equal(bus.upload_u(NODE, 0x1802, 2), 7, "1802 sub 2 after restart")
+            check_equal([bus.upload_u(NODE, 0x1A02, sub) for sub in (0, 1)], [1, DUMMY_U8], "1A02 after restart")
+            check_equal(bus.upload_u(NODE, 0x1015, 0), 0, "unsaved 1015 after restart")
+            bus.download(NODE, 0x1011, 1, LOAD, 4)
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "restored defaults wait for a reset")
+            bus.nmt(NMT_RESET_NODE, NODE)
+            bus.wait_state(NODE, STATE_BOOTUP)
+            check_equal(bus.upload_u(NODE, 0x1017, 0), 0, "1017 after restore and reset")
+            check_equal(bus.upload_u(NODE, 0x1802, 2), 1, "1802 sub 2 back to table 45's default")
+            server.stop()
+
+
+def lss_answer(bus, data, timeout=0.06):
+    """One LSS frame; the slave's answer (0x7E4) or None when nobody answers within `timeout`."""
+    bus.send(0x7E5, list(data) + [0] * (8 - len(data)))
+    frames = []
+    deadline = time.monotonic() + timeout
+    while not frames and time.monotonic() < deadline:
+        msg = bus.bus.recv(deadline - time.monotonic())
+        if msg is not None and msg.arbitration_id == 0x7E4:
+            frames.append(bytes(msg.data))
+    return frames[0] if frames else None
+
+
+def fast_scan(bus):
+    """python-canopen's LssMaster.fast_scan() in raw frames; the identity found, or None."""
+    def ask(id_number, bit_checked, lss_sub, lss_next):
+        return lss_answer(bus, [0x51] + list(struct.pack("<I", id_number)) + [bit_checked, lss_sub, lss_next]) \
+            is not None
+
+    if not ask(0, 0x80, 0, 0):
+        return None
+    found = [0, 0, 0, 0]
+    for lss_sub in range(4):
+        for bit_checked in range(31, -1, -1):
+            if not ask(found[lss_sub], bit_checked, lss_sub, lss_sub):
+                found[lss_sub] |= 1 << bit_checked
+        if not ask(found[lss_sub], 0, lss_sub, (lss_sub + 1) & 3):
+            return None
+    return found
+
+
+def test_slcan_lss_configure_and_fastscan(motwin):
+    """Switch state selective, inquire, configure node ID and store on a configured node; then the
+    node made unconfigured (2705 = 255), found by fastscan, configured and booted: all over SLCAN."""
+    with TempDir() as tmp:
+        state = os.path.join(tmp, "state")
+        with CanServer(MOTWIN, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
+            ident = [bus.upload_u(1, 0x1018, sub) for sub in (1, 2, 3, 4)]
+            check_equal(ident, [0x286, 3216, 0x00010004, 1], "identity of node 1")
+            for command, value in zip((0x40, 0x41, 0x42), ident[:3]):
+                check_equal(lss_answer(bus, [command] + list(struct.pack("<I", value)), timeout=0.1), None,
+                            f"answer to {command:#04x}")
+            check_equal(lss_answer(bus, [0x43] + list(struct.pack("<I", ident[3])), timeout=1.0),
+                        bytes([0x44]) + bytes(7), "switch state selective answer")
+            check_equal(lss_answer(bus, [0x5E], timeout=1.0)[:2], bytes([0x5E, 1]), "inquire node ID")
+            check_equal(lss_answer(bus, [0x11, 23], timeout=1.0)[:2], bytes([0x11, 0]), "configure node ID 23")
+            check_equal(lss_answer(bus, [0x17], timeout=1.0)[:2], bytes([0x17, 0]), "store configuration")
+            bus.send(0x7E5, [0x04, 0, 0, 0, 0, 0, 0, 0])  # waiting
+            bus.nmt(NMT_RESET_COMM, 1)
+            bus.wait_state(23, STATE_BOOTUP)
+            check_equal(bus.upload_u(23, 0x2705, 0), 23, "2705 stored by LSS")
+            check_equal(fast_scan(bus), None, "fastscan of a configured node")
+            bus.download(23, 0x2705, 0, 255, 1)
+            bus.download(23, 0x2706, 1, SAVE, 4)
+            server.stop()
+        with CanServer(MOTWIN, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
+            bus.send(0x623, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
+            check_equal(bus.collect(0.3, lambda m: m.arbitration_id != 0x7E4), [], "frames of an unconfigured node")
+            check_equal(fast_scan(bus), ident, "identity found by fastscan")
+            check_equal(lss_answer(bus, [0x11, 20], timeout=1.0)[:2], bytes([0x11, 0]), "configure node ID 20")
+            bus.send(0x7E5, [0x04, 0, 0, 0, 0, 0, 0, 0])  # waiting: the unconfigured node boots at once
+            bus.wait_state(20, STATE_BOOTUP)
+            check_equal(bus.upload_u(20, 0x1000, 0), 0xFFFF0192, "SDO to the new node ID")
+            server.stop()
 
 
 class RawSlcan:
@@ -97,7 +251,7 @@ def test_slcan_adapter_commands(motwin):
             check_equal(raw.command("t12"), b"\a", "short frame")
             check_equal(raw.command("t123" + "9" + "00" * 9), b"\a", "DLC 9")
             check_equal(raw.command("t60784000100000000000"), b"z\r", "SDO upload of 1000 to node 7")
-            check_equal(raw.read_answer(), b"t5878430010009201FCFF\r", "SDO answer after the acknowledgement")
+            check_equal(raw.read_answer(), b"t5878430010009201FFFF\r", "SDO answer after the acknowledgement")
             check_equal(raw.command(""), b"\r", "a bare CR")
             check_equal(raw.command("C"), b"\r", "close")
         finally:
@@ -110,7 +264,9 @@ def main():
     import motwin_harness
     args = motwin_harness.parse_arguments()
     MOTWIN = os.path.abspath(args.motwin)
-    run_tests([test_slcan_sdo_and_nmt, test_slcan_and_socketcand_share_the_bus, test_slcan_adapter_commands])
+    run_tests([test_slcan_sdo_and_nmt, test_slcan_and_socketcand_share_the_bus, test_slcan_adapter_commands,
+               test_slcan_pdo_sync_and_emcy, test_slcan_nmt_transitions, test_slcan_store_and_restore_across_restart,
+               test_slcan_lss_configure_and_fastscan])
 
 
 MOTWIN = None

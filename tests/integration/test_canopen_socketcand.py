@@ -6,7 +6,8 @@ boot-up after NMT resets; SDO reads of 1000, 1018 and 1008 (segmented); SDO writ
 of 1017 and heartbeats at that period (simulated-time stamps); abort codes for absent objects,
 sub-indices, read-only objects and wrong sizes; NMT start/stop/pre-operational with SDO refused
 while stopped; store/restore (1010/1011) across a restart of the server; two clients see each
-other's frames but not their own; garbage and malformed socketcand elements are tolerated.
+other's frames but not their own; garbage and malformed socketcand elements are tolerated;
+malformed SDO frames (DLC 4, command specifier 7, a wrong toggle bit) get their aborts.
 """
 
 import os
@@ -43,7 +44,7 @@ def test_bootup_after_nmt_reset(motwin):
 
 def test_sdo_reads_of_identity_objects(motwin):
     with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
-        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 device type")
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 device type")
         check_equal(bus.upload_u(NODE, 0x1018, 0), 4, "1018 sub 0")
         check_equal(bus.upload_u(NODE, 0x1018, 1), 0x286, "1018 vendor ID")
         check_equal(bus.upload_u(NODE, 0x1018, 2), 3216, "1018 product code")
@@ -76,7 +77,7 @@ def test_heartbeat_at_the_1017_period(motwin):
 def test_abort_codes(motwin):
     with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
         check_equal(bus.abort_code(bus.upload, NODE, 0x1234, 0), 0x06020000, "absent object")
-        check_equal(bus.abort_code(bus.upload, NODE, 0x6040, 0), 0x06020000, "CiA-402 object (not yet)")
+        check_equal(bus.abort_code(bus.upload, NODE, 0x6043, 0), 0x06020000, "object not in the dictionary (vl mode)")
         check_equal(bus.abort_code(bus.upload, NODE, 0x1018, 9), 0x06090011, "absent sub-index")
         check_equal(bus.abort_code(bus.download, NODE, 0x1000, 0, 1, 4), 0x06010002, "write to 1000")
         check_equal(bus.abort_code(bus.download, NODE, 0x1017, 0, 1, 4), 0x06070012, "1017 with 4 bytes")
@@ -88,7 +89,7 @@ def test_abort_codes(motwin):
         msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block upload answer")
         check_equal(bytes(msg.data), bytes([0x80, 0x08, 0x10, 0x00, 0x02, 0x00, 0x04, 0x05]), "block upload abort")
         # Still serving.
-        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000 after the aborts")
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 after the aborts")
         server.stop()
 
 
@@ -106,7 +107,7 @@ def test_nmt_start_stop_preop(motwin):
         bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)  # the heartbeat goes on
         bus.nmt(NMT_PREOP, NODE)
         bus.wait_state(NODE, STATE_PREOP, timeout=0.5)
-        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "SDO in pre-operational again")
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "SDO in pre-operational again")
         server.stop()
 
 
@@ -186,12 +187,12 @@ def test_garbage_and_malformed_elements_are_tolerated(motwin):
                 if element.startswith("< frame 585 "):
                     break
             parts = element.split()
-            check_equal(parts[4], "430010009201FCFF", "SDO answer data")
+            check_equal(parts[4], "430010009201FFFF", "SDO answer data")
             check(parts[3].count(".") == 1 and len(parts[3].split(".")[1]) == 6, f"timestamp {parts[3]}")
         finally:
             raw.close()
         with server.bus() as bus:
-            check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "server still serves")
+            check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "server still serves")
         server.stop()
 
 
@@ -204,6 +205,31 @@ def test_client_disconnect_mid_transfer(motwin):
             # The old transfer times out (05040000 after 1 s) or is replaced by this one.
             check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "a new transfer")
         check(server.alive(), "server alive")
+        server.stop()
+
+
+def test_malformed_sdo_frames_on_the_wire(motwin):
+    """Robustness with raw frames: an SDO request of 4 bytes, command specifier 7 and an upload
+    segment with the wrong toggle bit are aborted (05040001, 05040001, 05030000), and the server
+    goes on serving."""
+    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+        def exchange(data):
+            bus.send(0x600 + NODE, data)
+            msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, f"answer to {bytes(data).hex()}")
+            return bytes(msg.data)
+
+        check_equal(exchange([0x40, 0x00, 0x10, 0x00]), bytes([0x80, 0, 0, 0, 0x01, 0x00, 0x04, 0x05]),
+                    "SDO request with DLC 4: 05040001")
+        check_equal(exchange([0xE0, 0x00, 0x10, 0x00, 0, 0, 0, 0]), bytes([0x80, 0, 0, 0, 0x01, 0x00, 0x04, 0x05]),
+                    "command specifier 7: 05040001")
+        check_equal(exchange([0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0]), bytes([0x41, 0x08, 0x10, 0x00, 9, 0, 0, 0]),
+                    "initiate upload of 1008 (9 bytes, segmented)")
+        check_equal(exchange([0x70, 0, 0, 0, 0, 0, 0, 0]), bytes([0x80, 0x08, 0x10, 0x00, 0x00, 0x00, 0x03, 0x05]),
+                    "first upload segment with toggle 1: 05030000")
+        check_equal(exchange([0x60, 0, 0, 0, 0, 0, 0, 0]), bytes([0x80, 0, 0, 0, 0x01, 0x00, 0x04, 0x05]),
+                    "a segment after the abort: no transfer (05040001)")
+        check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "a good segmented upload afterwards")
+        check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "and an expedited one")
         server.stop()
 
 
@@ -242,7 +268,7 @@ def test_bus_capture_pcap_and_candump(motwin):
             with serve(tmp, extra_args=("--can-capture", path)) as server, server.bus() as bus:
                 bus.nmt(NMT_RESET_NODE, NODE)
                 bus.wait_state(NODE, STATE_BOOTUP)
-                check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFC0192, "1000")
+                check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000")
                 server.stop()
             data = open(path, "rb").read()
             if name.endswith(".pcap"):
@@ -259,7 +285,7 @@ def test_bus_capture_pcap_and_candump(motwin):
                 check_equal(frames[0][:2], (0x000, bytes([NMT_RESET_NODE, NODE])), "first frame: the NMT reset")
                 check_equal(frames[1][:2], (0x700 + NODE, b"\x00"), "boot-up")
                 check_equal(frames[2][:2], (0x600 + NODE, bytes([0x40, 0, 0x10, 0, 0, 0, 0, 0])), "SDO request")
-                check_equal(frames[3][:2], (0x580 + NODE, bytes([0x43, 0, 0x10, 0, 0x92, 1, 0xFC, 0xFF])),
+                check_equal(frames[3][:2], (0x580 + NODE, bytes([0x43, 0, 0x10, 0, 0x92, 1, 0xFF, 0xFF])),
                             "SDO response")
                 check(frames[0][2] <= frames[3][2], "timestamps in order")
             else:
@@ -267,7 +293,7 @@ def test_bus_capture_pcap_and_candump(motwin):
                 check(len(lines) >= 4, f"candump lines {lines!r}")
                 check(lines[0].endswith(f" can0 000#81{NODE:02X}"), f"line 1 {lines[0]!r}")
                 check(lines[1].endswith(f" can0 7{NODE:02X}#00"), f"line 2 {lines[1]!r}")
-                check(lines[3].endswith(f" can0 58{NODE:X}#430010009201FCFF"), f"line 4 {lines[3]!r}")
+                check(lines[3].endswith(f" can0 58{NODE:X}#430010009201FFFF"), f"line 4 {lines[3]!r}")
                 check(lines[0].startswith("(") and ") can0 " in lines[0], "candump -L form")
 
 
@@ -311,6 +337,7 @@ def main():
         test_clients_see_each_other_but_not_themselves,
         test_garbage_and_malformed_elements_are_tolerated,
         test_client_disconnect_mid_transfer,
+        test_malformed_sdo_frames_on_the_wire,
         test_heartbeat_consumer_emcy,
         test_bus_capture_pcap_and_candump,
         test_serve_argument_errors,

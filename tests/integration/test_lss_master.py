@@ -2,7 +2,8 @@
 """`motwin lss` (a CiA-305 master, src/tools/lss_client.*) against the TMCM-3216's LSS slave on
 one virtual bus: switch state global and selective, inquire identity and node ID, configure and
 store a node ID (it survives a restart), and fastscan finding two unconfigured modules one
-after the other by their serial numbers. The master's frames are checked in a candump capture.
+after the other by their serial numbers; activate bit timing switching the node's rate (2707).
+The master's frames are checked in a candump capture.
 """
 
 import os
@@ -86,7 +87,7 @@ def test_configure_store_and_inquire(motwin):
         with BusServer(motwin, state, ["--module", "tmcm-3216", "--can", "socketcand:127.0.0.1:0"]) as server:
             client = CanopenClient(server.port())
             try:
-                check_equal(client.upload_u(9, 0x1000, 0), 0xFFFC0192, "node 9 after a restart")
+                check_equal(client.upload_u(9, 0x1000, 0), 0xFFFF0192, "node 9 after a restart")
             finally:
                 client.close()
             server.stop()
@@ -123,5 +124,36 @@ def test_fastscan_finds_unconfigured_modules(motwin):
             server.stop()
 
 
+def test_activate_bitrate(motwin):
+    # A bus without bit timing (--can-bitrate 0), so that the node stays reachable at its new rate.
+    with TempDir() as tmp:
+        capture = os.path.join(tmp, "bus.log")
+        args = ["--module", "tmcm-3216", "--node-id", "5", "--can", "socketcand:127.0.0.1:0", "--can-bitrate", "0",
+                "--can-capture", capture]
+        with BusServer(motwin, os.path.join(tmp, "state"), args) as server:
+            client = CanopenClient(server.port())
+            try:
+                check_equal(client.upload_u(5, 0x2707, 0), 1000, "2707 before")
+                lss_ok(motwin, server, "switch-global", "configuration")
+                lss_ok(motwin, server, "set-bitrate", "250")
+                status, _, err = lss(motwin, server, "activate-bitrate", "70000")
+                check_equal(status, 2, f"a switch delay above 65535 ms ({err})")
+                check_equal(lss_ok(motwin, server, "activate-bitrate", "100"), "", "activate-bitrate output")
+                lss_ok(motwin, server, "switch-global", "waiting")
+                # Active after twice the delay (200 ms of simulated time); a loaded machine may lag.
+                deadline = time.monotonic() + 3.0
+                while client.upload_u(5, 0x2707, 0) != 250 and time.monotonic() < deadline:
+                    time.sleep(0.05)
+                check_equal(client.upload_u(5, 0x2707, 0), 250, "2707 after the activation")
+                check_equal(client.upload_u(5, 0x2704, 0), 1000, "2704: an activated rate is not stored")
+            finally:
+                client.close()
+            server.stop()
+        master = [data for cob, data in candump_frames(capture) if cob == 0x7E5]
+        check_equal(master, [bytes([0x04, 0x01, 0, 0, 0, 0, 0, 0]), bytes([0x13, 0, 3, 0, 0, 0, 0, 0]),
+                             bytes([0x15, 100, 0, 0, 0, 0, 0, 0]), bytes([0x04, 0, 0, 0, 0, 0, 0, 0])],
+                    "the master's frames: configuration, bit timing 250 (index 3), activate 100 ms, waiting")
+
+
 if __name__ == "__main__":
-    run_tests([test_configure_store_and_inquire, test_fastscan_finds_unconfigured_modules])
+    run_tests([test_configure_store_and_inquire, test_fastscan_finds_unconfigured_modules, test_activate_bitrate])

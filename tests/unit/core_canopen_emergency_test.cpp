@@ -1,6 +1,6 @@
 // EMCY producer (src/core/canopen/emergency.h) and heartbeat consumer (heartbeat_consumer.h) in
 // the TMCM-3216: EMCY 8130 on a heartbeat timeout with 1001 bit 4, EMCY 0000 on recovery, the
-// 1029 error behaviour, the 1015 inhibit time and 1014 bit 31.
+// 1029 error behaviour, the 1015 inhibit time (producer API and written by SDO) and 1014 bit 31.
 #include <gtest/gtest.h>
 
 #include "core/canopen/emergency.h"
@@ -22,7 +22,7 @@ std::vector<can::CanFrame> emcy_frames(const std::vector<can::CanFrame>& frames,
 
 void ticks(Tmcm3216Rig& rig, int count, std::vector<can::CanFrame>& out) {
   for (int i = 0; i < count; ++i) {
-    rig.device->tick();
+    rig.device->process(1000);  // 1 ms of the services
     for (const can::CanFrame& f : rig.can.take()) out.push_back(f);
   }
 }
@@ -107,6 +107,110 @@ TEST(Emergency, inhibit_time_spaces_messages) {
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].id, 0x85u);
   EXPECT_EQ(out[0].data[0], 0x00);
+}
+
+TEST(Emergency, inhibit_time_written_to_1015_spaces_the_rpdo_emcys) {
+  // 1015 = 100 (10 ms) by SDO; RPDO 1 (6040, 2 bytes, table 41) with 1 byte raises 8210 at once,
+  // the correct RPDO right after it clears the error, and its EMCY 0000 waits out the 10 ms.
+  Tmcm3216Rig rig;
+  ASSERT_EQ(rig.download(0x1015, 0, 100, 2), 0u);
+  EXPECT_EQ(rig.read_u32(0x1015, 0), 100u);
+  rig.nmt(0x01, rig.node());
+  const uint32_t emcy_id = 0x80u + rig.node();
+  const uint32_t rpdo1 = 0x200u + rig.node();
+
+  std::vector<can::CanFrame> emcy = emcy_frames(rig.send(frame_of(rpdo1, {0x06})), emcy_id);
+  ASSERT_EQ(emcy.size(), 1u);
+  const uint8_t too_short[8] = {0x10, 0x82, 0x11, 0x00, 0xFF, 0x00, 0x00, 0x00};
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(emcy[0].data[i], too_short[i]) << i;
+
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x00, 0x00})), emcy_id).empty()) << "inhibited";
+  EXPECT_EQ(rig.read_u32(0x1001, 0) & 0xFF, 0u) << "the error is gone, its EMCY waits";
+  int sent_at_ms = -1;
+  for (int ms = 1; ms <= 20 && sent_at_ms < 0; ++ms) {
+    std::vector<can::CanFrame> out;
+    ticks(rig, 1, out);
+    emcy = emcy_frames(out, emcy_id);
+    if (emcy.empty()) continue;
+    sent_at_ms = ms;
+    ASSERT_EQ(emcy.size(), 1u);
+    const uint8_t reset[8] = {0x00, 0x00, 0x00, 0x00, 0xFF, 0x00, 0x00, 0x00};
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(emcy[0].data[i], reset[i]) << i;
+  }
+  EXPECT_EQ(sent_at_ms, 10) << "10 ms after the 8210";
+
+  // 1015 = 0 again (the running inhibit time of the EMCY 0000 ends first): back-to-back EMCYs
+  // go out together.
+  ASSERT_EQ(rig.download(0x1015, 0, 0, 2), 0u);
+  std::vector<can::CanFrame> out;
+  ticks(rig, 10, out);
+  EXPECT_TRUE(emcy_frames(out, emcy_id).empty());
+  out = rig.send(frame_of(rpdo1, {0x06}));
+  for (const can::CanFrame& f : rig.send(frame_of(rpdo1, {0x00, 0x00}))) out.push_back(f);
+  emcy = emcy_frames(out, emcy_id);
+  ASSERT_EQ(emcy.size(), 2u);
+  EXPECT_EQ(emcy[0].data[1], 0x82);
+  EXPECT_EQ(emcy[1].data[1], 0x00);
+}
+
+// RPDO 1 of axis 0 remapped to 6060 (modes of operation, 1 byte): mode 2 is not supported and
+// refused by the object, so the PDO's data "cannot be accepted" (manual table 365): EMCY 6320 once,
+// byte 2 = 255, 1001 generic; 0000 when an RPDO is written whole again. Synchronous: at the SYNC.
+void map_rpdo1_to_6060(Tmcm3216Rig& rig, uint32_t transmission_type) {
+  const uint32_t cob_id = 0x200u + rig.node();
+  ASSERT_EQ(rig.download(0x1400, 1, cob_id | 0x8000'0000u, 4), 0u);
+  ASSERT_EQ(rig.download(0x1400, 2, transmission_type, 1), 0u);
+  ASSERT_EQ(rig.download(0x1600, 0, 0, 1), 0u);
+  ASSERT_EQ(rig.download(0x1600, 1, 0x6060'0008u, 4), 0u);
+  ASSERT_EQ(rig.download(0x1600, 0, 1, 1), 0u);
+  ASSERT_EQ(rig.download(0x1400, 1, cob_id, 4), 0u);
+}
+
+TEST(Emergency, rpdo_value_the_object_refuses_sends_6320_once_and_0000_after_a_good_rpdo) {
+  Tmcm3216Rig rig;
+  map_rpdo1_to_6060(rig, 0xFF);
+  rig.nmt(0x01, rig.node());
+  const uint32_t emcy_id = 0x80u + rig.node();
+  const uint32_t rpdo1 = 0x200u + rig.node();
+
+  std::vector<can::CanFrame> emcy = emcy_frames(rig.send(frame_of(rpdo1, {0x02})), emcy_id);
+  ASSERT_EQ(emcy.size(), 1u);
+  const uint8_t parameter_error[8] = {0x20, 0x63, 0x01, 0x00, 0xFF, 0x00, 0x00, 0x00};
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(emcy[0].data[i], parameter_error[i]) << i;
+  EXPECT_EQ(rig.read_u32(0x1001, 0) & 0xFF, 0x01u);
+  EXPECT_EQ(rig.read_u32(0x6060, 0) & 0xFF, 0u) << "the refused value is not written";
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x07})), emcy_id).empty()) << "one EMCY per episode";
+
+  emcy = emcy_frames(rig.send(frame_of(rpdo1, {0x01})), emcy_id);
+  ASSERT_EQ(emcy.size(), 1u);
+  const uint8_t reset[8] = {0x00, 0x00, 0x00, 0x00, 0xFF, 0x00, 0x00, 0x00};
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(emcy[0].data[i], reset[i]) << i;
+  EXPECT_EQ(rig.read_u32(0x1001, 0) & 0xFF, 0u);
+  EXPECT_EQ(rig.read_u32(0x6060, 0) & 0xFF, 1u);
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x03})), emcy_id).empty()) << "nothing to clear";
+}
+
+TEST(Emergency, synchronous_rpdo_value_is_judged_at_the_sync) {
+  Tmcm3216Rig rig;
+  map_rpdo1_to_6060(rig, 1);
+  rig.nmt(0x01, rig.node());
+  const uint32_t emcy_id = 0x80u + rig.node();
+  const uint32_t rpdo1 = 0x200u + rig.node();
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x02})), emcy_id).empty()) << "kept for the SYNC";
+  std::vector<can::CanFrame> emcy = emcy_frames(rig.send(frame_of(0x80, {})), emcy_id);
+  ASSERT_EQ(emcy.size(), 1u);
+  EXPECT_EQ(emcy[0].data[0], 0x20);
+  EXPECT_EQ(emcy[0].data[1], 0x63);
+  // The same bad value every cycle: no EMCY per SYNC.
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x02})), emcy_id).empty());
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(0x80, {})), emcy_id).empty());
+  // A good value: 0000 at its SYNC, not at its reception.
+  EXPECT_TRUE(emcy_frames(rig.send(frame_of(rpdo1, {0x03})), emcy_id).empty());
+  emcy = emcy_frames(rig.send(frame_of(0x80, {})), emcy_id);
+  ASSERT_EQ(emcy.size(), 1u);
+  EXPECT_EQ(emcy[0].data[0], 0x00);
+  EXPECT_EQ(emcy[0].data[1], 0x00);
+  EXPECT_EQ(rig.read_u32(0x6060, 0) & 0xFF, 3u);
 }
 
 TEST(Emergency, cob_id_bit_31_switches_the_producer_off) {

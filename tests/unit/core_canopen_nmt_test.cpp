@@ -66,7 +66,7 @@ TEST(Nmt, sdo_is_not_answered_while_stopped) {
   rig.nmt(0x02, 1);
   EXPECT_TRUE(rig.send(frame_of(0x601, {0x40, 0x00, 0x10, 0, 0, 0, 0, 0})).empty());
   rig.nmt(0x80, 1);
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);
 }
 
 TEST(Nmt, stopping_drops_a_segmented_transfer) {
@@ -79,7 +79,7 @@ TEST(Nmt, stopping_drops_a_segmented_transfer) {
 TEST(Nmt, heartbeat_follows_1017_period) {
   Tmcm3216Rig rig;
   rig.can.take();  // boot-up
-  for (int i = 0; i < 2000; ++i) rig.device->tick();
+  for (int i = 0; i < 2000; ++i) rig.device->process(1000);  // 1 ms of the services
   EXPECT_TRUE(rig.can.take().empty()) << "no heartbeat while 1017 = 0";
   ASSERT_EQ(rig.download(0x1017, 0, 100, 2), 0u);
   // The first heartbeat goes out in the process call of the write, then one every 100 ms.
@@ -87,7 +87,7 @@ TEST(Nmt, heartbeat_follows_1017_period) {
   EXPECT_EQ(rig.other[0].id, 0x701u);
   std::vector<int> times_ms;
   for (int ms = 1; ms <= 1000; ++ms) {
-    rig.device->tick();
+    rig.device->process(1000);  // 1 ms of the services
     for (const can::CanFrame& f : rig.can.take()) {
       ASSERT_EQ(f.id, 0x701u);
       ASSERT_EQ(f.dlc, 1);
@@ -102,7 +102,7 @@ TEST(Nmt, heartbeat_follows_1017_period) {
 TEST(Nmt, heartbeat_reports_the_state_and_goes_out_on_state_change) {
   Tmcm3216Rig rig;
   ASSERT_EQ(rig.download(0x1017, 0, 1000, 2), 0u);
-  rig.device->tick();
+  rig.device->process(1000);  // 1 ms of the services
   rig.can.take();
   rig.other.clear();
   std::vector<can::CanFrame> out = rig.send(frame_of(0x000, {0x01, 0x01}));
@@ -111,7 +111,7 @@ TEST(Nmt, heartbeat_reports_the_state_and_goes_out_on_state_change) {
   out = rig.send(frame_of(0x000, {0x02, 0x01}));
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].data[0], 0x04);
-  for (int i = 0; i < 1000; ++i) rig.device->tick();
+  for (int i = 0; i < 1000; ++i) rig.device->process(1000);  // 1 ms of the services
   out = rig.can.take();
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].data[0], 0x04);  // heartbeat continues while stopped
@@ -142,7 +142,7 @@ TEST(Nmt, heartbeat_period_survives_reset_communication_from_storage) {
   rig.nmt(0x82, 1);
   EXPECT_EQ(rig.read_u32(0x1017, 0) & 0xFFFF, 50u);
   rig.can.take();
-  for (int i = 0; i < 100; ++i) rig.device->tick();
+  for (int i = 0; i < 100; ++i) rig.device->process(1000);  // 1 ms of the services
   // The boot-up restarts the period: heartbeats at 50 and 100 ms.
   EXPECT_EQ(with_id(rig.can.take(), 0x701).size(), 2u);
 }

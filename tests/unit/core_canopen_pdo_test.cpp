@@ -29,6 +29,7 @@ class ValueDictionary final : public canopen::ObjectDictionary {
   int64_t values[3] = {0, 0, 0};
 
   SdoAbort find(uint16_t index, uint8_t sub, ObjectRef& out) const override {
+    ++finds;
     if (index < 0x2000 || index > 0x2002) return SdoAbort::kNoObject;
     if (sub != 0) return SdoAbort::kNoSubIndex;
     out = ObjectRef{&kInfo[index - 0x2000], static_cast<size_t>(index - 0x2000), index, 0};
@@ -51,6 +52,7 @@ class ValueDictionary final : public canopen::ObjectDictionary {
     return SdoAbort::kNone;
   }
   int writes = 0;
+  mutable int finds = 0;  // the PDOs resolve a mapping once, not at every frame
 
  private:
   static const EntryInfo kInfo[3];
@@ -202,6 +204,123 @@ TEST(Pdo, tpdo_mapping_an_absent_object_is_inactive) {
   EXPECT_TRUE(rig.frames_on(0x181).empty());
 }
 
+TEST(Pdo, mappings_are_resolved_once_and_again_after_a_change) {
+  PdoRig rig;
+  rig.pdos.enter_operational();
+  // Every PDO used once: each mapping resolved.
+  ASSERT_EQ(rig.pdos.on_frame(frame_of(0x201, {1, 0, 2, 0, 0, 0})), RpdoReception::kAccepted);
+  ASSERT_EQ(rig.pdos.on_frame(frame_of(0x301, {1, 0})), RpdoReception::kAccepted);
+  rig.pdos.on_sync();
+  rig.pdos.on_sync();
+  rig.pdos.process(0);
+  EXPECT_EQ(rig.can.take().size(), 2u);  // TPDO 1 (entering operational) and TPDO 2 (second SYNC)
+  const int finds = rig.dictionary.finds;
+  EXPECT_GT(finds, 0);
+  for (int i = 0; i < 10; ++i) {
+    rig.pdos.on_frame(frame_of(0x201, {static_cast<uint8_t>(i), 0, 2, 0, 0, 0}));
+    rig.pdos.on_frame(frame_of(0x301, {static_cast<uint8_t>(i), 0}));
+    rig.pdos.on_sync();
+    rig.pdos.process(1000);
+  }
+  EXPECT_EQ(rig.dictionary.finds, finds);  // every object reached through its kept reference
+  EXPECT_EQ(rig.dictionary.values[0], 9);
+  rig.rpdo_mapping[0].entries[1] = 0x2000'0010;  // a remap resolves that mapping again
+  rig.rpdo_mapping[0].entries[0] = 0x2001'0020;
+  rig.pdos.on_frame(frame_of(0x201, {7, 0, 0, 0, 0x10, 0}));
+  EXPECT_GT(rig.dictionary.finds, finds);
+  EXPECT_EQ(rig.dictionary.values[1], 7);
+  EXPECT_EQ(rig.dictionary.values[0], 0x10);
+}
+
+TEST(Pdo, remapped_rpdo_writes_the_new_objects_with_the_new_length) {
+  PdoRig rig;
+  ASSERT_EQ(rig.pdos.on_frame(frame_of(0x201, {0x34, 0x12, 0x05, 0, 0, 0})), RpdoReception::kAccepted);
+  EXPECT_EQ(rig.dictionary.values[0], 0x1234);
+  EXPECT_EQ(rig.dictionary.values[1], 5);
+  rig.rpdo_mapping[0] = PdoMapping{1, {0x2001'0020}};
+  EXPECT_EQ(rig.pdos.on_frame(frame_of(0x201, {0x06, 0, 0, 0})), RpdoReception::kAccepted);
+  EXPECT_EQ(rig.dictionary.values[1], 6);
+  EXPECT_EQ(rig.dictionary.values[0], 0x1234);  // no longer mapped
+  EXPECT_EQ(rig.pdos.on_frame(frame_of(0x201, {0x07, 0, 0, 0, 0x99, 0x99})), RpdoReception::kTooLong);
+  EXPECT_EQ(rig.dictionary.values[1], 7);
+  EXPECT_EQ(rig.dictionary.values[0], 0x1234);
+  // Mapped to a read-only object: inactive, frames ignored; mapped back: written again.
+  rig.rpdo_mapping[0] = PdoMapping{1, {0x2002'0008}};
+  const int writes = rig.dictionary.writes;
+  EXPECT_EQ(rig.pdos.on_frame(frame_of(0x201, {0x08})), RpdoReception::kAccepted);
+  EXPECT_EQ(rig.dictionary.writes, writes);
+  rig.rpdo_mapping[0] = PdoMapping{2, {0x0006'0010, 0x2000'0010}};  // dummy U16, then 2000
+  EXPECT_EQ(rig.pdos.on_frame(frame_of(0x201, {0xFF, 0xFF, 0x21, 0x43})), RpdoReception::kAccepted);
+  EXPECT_EQ(rig.dictionary.values[0], 0x4321);
+}
+
+TEST(Pdo, synchronous_rpdo_remapped_before_the_sync_uses_the_new_mapping_or_drops_short_data) {
+  PdoRig rig;
+  rig.pdos.on_frame(frame_of(0x301, {0x11, 0x00}));
+  rig.rpdo_mapping[1] = PdoMapping{1, {0x2001'0020}};  // 4 bytes: the 2 kept do not fill it
+  rig.pdos.on_sync();
+  EXPECT_EQ(rig.dictionary.writes, 0);
+  rig.rpdo_mapping[1] = PdoMapping{1, {0x2002'0008}};  // inactive (read-only object): frames ignored
+  EXPECT_EQ(rig.pdos.on_frame(frame_of(0x301, {0x22, 0x00})), RpdoReception::kAccepted);
+  rig.pdos.on_sync();
+  EXPECT_EQ(rig.dictionary.writes, 0);
+  rig.rpdo_mapping[1] = PdoMapping{1, {0x2001'0020}};
+  rig.pdos.on_frame(frame_of(0x301, {0x33, 0x00, 0x00, 0x00}));
+  rig.pdos.on_sync();
+  EXPECT_EQ(rig.dictionary.values[1], 0x33);
+}
+
+TEST(Pdo, remapped_tpdo_carries_the_new_object) {
+  PdoRig rig;
+  rig.dictionary.values[0] = 0xBEEF;
+  rig.dictionary.values[1] = -2;
+  rig.dictionary.values[2] = 7;
+  rig.pdos.enter_operational();
+  rig.pdos.process(0);
+  auto tpdo = rig.frames_on(0x181);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(tpdo[0].dlc, 3);
+  rig.tpdo_mapping[0] = PdoMapping{2, {0x2001'0020, 0x2002'0008}};
+  rig.pdos.process(1000);  // what the PDO carries changed: sent
+  tpdo = rig.frames_on(0x181);
+  ASSERT_EQ(tpdo.size(), 1u);
+  ASSERT_EQ(tpdo[0].dlc, 5);
+  const uint8_t expected[5] = {0xFE, 0xFF, 0xFF, 0xFF, 7};
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(tpdo[0].data[i], expected[i]) << i;
+  rig.dictionary.values[0] = 1;  // no longer mapped: no change
+  rig.pdos.process(1000);
+  EXPECT_TRUE(rig.frames_on(0x181).empty());
+  rig.dictionary.values[1] = 3;
+  rig.pdos.process(1000);
+  tpdo = rig.frames_on(0x181);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(tpdo[0].data[0], 3);
+  // The synchronous TPDO: remapped between two SYNCs, the next one carries the new object.
+  rig.pdos.on_sync();
+  rig.pdos.on_sync();
+  tpdo = rig.frames_on(0x281);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(tpdo[0].dlc, 3);
+  rig.tpdo_mapping[1] = PdoMapping{1, {0x2002'0008}};
+  rig.pdos.on_sync();
+  rig.pdos.on_sync();
+  tpdo = rig.frames_on(0x281);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(tpdo[0].dlc, 1);
+  EXPECT_EQ(tpdo[0].data[0], 7);
+}
+
+TEST(Pdo, tpdo_mapped_back_from_an_absent_object_goes_out_again) {
+  PdoRig rig;
+  rig.tpdo_mapping[0].entries[1] = 0x6041'0010;
+  rig.pdos.enter_operational();
+  for (int i = 0; i < 5; ++i) rig.pdos.process(1000);
+  EXPECT_TRUE(rig.frames_on(0x181).empty());
+  rig.tpdo_mapping[0].entries[1] = 0x2002'0008;
+  rig.pdos.process(1000);
+  EXPECT_EQ(rig.frames_on(0x181).size(), 1u);
+}
+
 TEST(Sync, producer_sends_every_period_only_when_enabled_and_active) {
   RecordingCanController can;
   canopen::SyncService sync(can);
@@ -236,7 +355,7 @@ std::vector<can::CanFrame> run_ms(Tmcm3216Rig& rig, int ms) {
   std::vector<can::CanFrame> out;
   rig.can.take();
   for (int i = 0; i < ms; ++i) {
-    rig.device->tick();
+    rig.device->process(1000);  // 1 ms of the services
     for (const can::CanFrame& f : rig.can.take()) out.push_back(f);
   }
   return out;
@@ -302,7 +421,7 @@ TEST(Tmcm3216Pdo, event_timer_and_inhibit_time_after_python_canopen_reconfigurat
   EXPECT_EQ(at_start[0].data[0], 0);
   std::vector<int> sent_at_ms;
   for (int ms = 1; ms <= 80; ++ms) {
-    rig.device->tick();
+    rig.device->process(1000);  // 1 ms of the services
     if (!only(rig.can.take(), 0x181).empty()) sent_at_ms.push_back(ms);
   }
   EXPECT_EQ(sent_at_ms, (std::vector<int>{25, 50, 75}));  // event timer 10 ms, held back by 25 ms
@@ -334,6 +453,58 @@ TEST(Tmcm3216Pdo, pdos_of_axis_1_use_their_own_parameters) {
   const auto tpdo = only(frames, 0x2C1);
   ASSERT_EQ(tpdo.size(), 1u);
   EXPECT_EQ(tpdo[0].dlc, 2);
+}
+
+// The same for an RPDO (sub 1 and 2 only).
+void configure_rpdo_like_python_canopen(Tmcm3216Rig& rig, uint16_t comm, uint32_t cob_id, uint8_t type,
+                                        std::vector<uint32_t> entries) {
+  const uint16_t map = static_cast<uint16_t>(comm + 0x200);
+  ASSERT_EQ(rig.download(comm, 1, cob_id | 0x8000'0000u), 0u);
+  ASSERT_EQ(rig.download(comm, 2, type, 1), 0u);
+  ASSERT_EQ(rig.download(map, 0, 0, 1), 0u);
+  for (size_t i = 0; i < entries.size(); ++i) {
+    ASSERT_EQ(rig.download(map, static_cast<uint8_t>(i + 1), entries[i]), 0u);
+  }
+  ASSERT_EQ(rig.download(map, 0, static_cast<uint32_t>(entries.size()), 1), 0u);
+  ASSERT_EQ(rig.download(comm, 1, cob_id), 0u);
+}
+
+TEST(Tmcm3216Pdo, remapped_pdos_of_axes_1_and_2_carry_the_new_objects) {
+  Tmcm3216Rig rig;
+  // RPDO 1 of axis 1 (1440): 6881 profile velocity of axis 1. TPDO 1 of axis 2 (1880),
+  // synchronous: 7081 profile velocity of axis 2.
+  configure_rpdo_like_python_canopen(rig, 0x1440, 0x215, 0xFF, {0x6881'0020});
+  configure_tpdo_like_python_canopen(rig, 0x1880, 0x1A5, 1, 0, 0, {0x7081'0020});
+  ASSERT_EQ(rig.download(0x7081, 0, 1111), 0u);
+  ASSERT_EQ(rig.download(0x7083, 0, 2222), 0u);
+  rig.nmt(0x01, 1);
+  rig.send(frame_of(0x215, {0x39, 0x30, 0, 0}));  // 12345
+  EXPECT_EQ(rig.read_u32(0x6881, 0), 12345u);
+  auto tpdo = only(rig.send(frame_of(0x080, {})), 0x1A5);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(le32(tpdo[0], 0), 1111u);
+  // Remapped while operational (each PDO not valid meanwhile), each to the profile acceleration
+  // of its axis (6883, 7083): no NMT transition resets the PDO service in between.
+  configure_rpdo_like_python_canopen(rig, 0x1440, 0x215, 0xFF, {0x6883'0020});
+  configure_tpdo_like_python_canopen(rig, 0x1880, 0x1A5, 1, 0, 0, {0x7083'0020});
+  ASSERT_EQ(rig.device->nmt_state(), canopen::NmtState::kOperational);
+  rig.send(frame_of(0x215, {0x31, 0xD4, 0, 0}));  // 54321
+  EXPECT_EQ(rig.read_u32(0x6883, 0), 54321u);
+  EXPECT_EQ(rig.read_u32(0x6881, 0), 12345u);  // no longer mapped
+  tpdo = only(rig.send(frame_of(0x080, {})), 0x1A5);
+  ASSERT_EQ(tpdo.size(), 1u);
+  EXPECT_EQ(le32(tpdo[0], 0), 2222u);
+  // Restore defaults (1011 sub 1) and a reset: the default mappings and COB-IDs again (the PDOs
+  // of axes 1 and 2 not valid).
+  ASSERT_EQ(rig.download(0x1011, 1, 0x64616F6C), 0u);
+  rig.nmt(0x81, 1);
+  EXPECT_EQ(rig.read_u32(0x1A80, 1), 0x7041'0010u);
+  EXPECT_EQ(rig.read_u32(0x1640, 1), 0x6840'0010u);
+  rig.nmt(0x01, 1);
+  const uint32_t acceleration = rig.read_u32(0x6883, 0);
+  rig.send(frame_of(0x215, {0x01, 0x00, 0, 0}));
+  EXPECT_EQ(rig.read_u32(0x6883, 0), acceleration);
+  EXPECT_TRUE(only(rig.send(frame_of(0x080, {})), 0x1A5).empty());
 }
 
 TEST(Tmcm3216Pdo, rpdo_length_errors_send_emcy_8210_and_8220_and_0000_when_cleared) {
@@ -377,7 +548,7 @@ TEST(Tmcm3216Pdo, receive_queue_overrun_sends_emcy_8110_then_0000) {
   EXPECT_EQ(emcy[0].data[1], 0x81);
   EXPECT_EQ(emcy[0].data[2], 0x11);
   EXPECT_EQ(rig.device->communication_errors(), Tmcm3216::kCommErrorCanOverrun);
-  rig.device->tick();  // a tick without losses
+  rig.device->process(1000);  // 1 ms of the services  // a tick without losses
   emcy = only(rig.can.take(), 0x81);
   ASSERT_EQ(emcy.size(), 1u);
   EXPECT_EQ(emcy[0].data[0], 0x00);

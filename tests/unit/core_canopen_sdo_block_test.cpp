@@ -403,7 +403,7 @@ TEST(SdoBlock, protocol_switch_threshold_answers_small_objects_with_a_normal_upl
   // pst 21, 1000 (4 bytes): expedited.
   r = rig.sdo({0xA4, 0x00, 0x10, 0x00, 127, 21, 0, 0});
   EXPECT_EQ(r.data[0], 0x43);
-  EXPECT_EQ(le32(r, 4), 0xFFFC0192u);
+  EXPECT_EQ(le32(r, 4), 0xFFFF0192u);
   // pst 0 (python-canopen): block transfer even for 4 bytes.
   r = rig.sdo({0xA4, 0x00, 0x10, 0x00, 127, 0, 0, 0});
   EXPECT_EQ(r.data[0], 0xC6);

@@ -20,7 +20,7 @@ TEST(SdoServer, expedited_upload_of_device_type_and_identity) {
   const SdoResult device_type = rig.upload(0x1000, 0);
   EXPECT_EQ(device_type.abort, 0u);
   EXPECT_EQ(device_type.response.data[0], 0x43);  // expedited, size indicated, 4 bytes
-  EXPECT_EQ(device_type.value, 0xFFFC0192u);
+  EXPECT_EQ(device_type.value, 0xFFFF0192u);
   EXPECT_EQ(rig.read_u32(0x1018, 1), 0x286u);
   EXPECT_EQ(rig.read_u32(0x1018, 2), 3216u);
   EXPECT_EQ(rig.read_u32(0x1018, 3), 0x00010004u);
@@ -128,7 +128,8 @@ TEST(SdoServer, unknown_objects_and_sub_indices_abort) {
   EXPECT_EQ(rig.upload(0x1234, 0).abort, 0x06020000u);
   EXPECT_EQ(rig.upload(0x1018, 5).abort, 0x06090011u);
   EXPECT_EQ(rig.upload(0x1017, 1).abort, 0x06090011u);
-  EXPECT_EQ(rig.download(0x6040, 0, 6, 2), 0x06020000u);  // CiA-402 objects come with the drive issue
+  EXPECT_EQ(rig.download(0x6043, 0, 6, 2), 0x06020000u);  // vl mode objects: not supported
+  EXPECT_EQ(rig.download(0x7840, 0, 6, 2), 0x06020000u);  // no fourth axis
   EXPECT_EQ(rig.download(0x1010, 7, 0x65766173), 0x06090011u);
   // PDO parameters exist for three axes only.
   EXPECT_EQ(rig.upload(0x1440, 1).abort, 0u);
@@ -154,7 +155,7 @@ TEST(SdoServer, writes_to_read_only_and_const_objects_abort_06010002) {
   EXPECT_EQ(rig.download(0x1018, 0, 4, 1), 0x06010002u);
   EXPECT_EQ(rig.download(0x2708, 0, 5, 1), 0x06010002u);
   EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({0x21, 0x08, 0x10, 0, 3, 0, 0, 0})), 0x06010002u);  // segmented
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);
 }
 
 TEST(SdoServer, values_out_of_range_abort_06090030_31_32) {
@@ -192,7 +193,7 @@ TEST(SdoServer, pdo_mapping_changes_while_valid_abort_08000022) {
 TEST(SdoServer, command_specifier_7_aborts_05040001) {
   Tmcm3216Rig rig;
   EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({0xE0, 0, 0, 0, 0, 0, 0, 0})), 0x05040001u);
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);  // still serving
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);  // still serving
 }
 
 TEST(SdoServer, segments_out_of_sequence_abort_05040001) {
@@ -210,7 +211,7 @@ TEST(SdoServer, short_frames_abort_05040001_and_keep_serving) {
   Tmcm3216Rig rig;
   EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({0x40, 0x00, 0x10})), 0x05040001u);
   EXPECT_EQ(Tmcm3216Rig::abort_of(rig.sdo({})), 0x05040001u);
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);
 }
 
 TEST(SdoServer, client_abort_ends_a_transfer_silently) {
@@ -230,9 +231,9 @@ TEST(SdoServer, segmented_transfer_times_out_with_05040000) {
   Tmcm3216Rig rig;
   rig.sdo({0x40, 0x08, 0x10, 0, 0, 0, 0, 0});
   rig.can.take();
-  for (int ms = 0; ms < 999; ++ms) rig.device->tick();
+  for (int ms = 0; ms < 999; ++ms) rig.device->process(1000);  // 1 ms of the services
   EXPECT_TRUE(rig.can.take().empty());
-  rig.device->tick();
+  rig.device->process(1000);  // 1 ms of the services
   const std::vector<can::CanFrame> out = rig.can.take();
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(Tmcm3216Rig::abort_of(out[0]), 0x05040000u);

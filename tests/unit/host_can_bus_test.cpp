@@ -239,7 +239,7 @@ TEST(SocketcandServer, serves_an_sdo_exchange_and_never_echoes) {
   received.clear();
   send_text("< rawmode >");
   ASSERT_TRUE(testing::pump_until(step, [&] { return has("< ok >"); }));
-  module.run_ticks(2500);  // 2.5 s of sim time
+  module.run_ticks(2'500'000 / module.tick_period_us());  // 2.5 s of sim time
   send_text("< send 603 8 40 18 10 2 0 0 0 0 >");
   // Held for SocketcandServer::kRawModeSettleUs after rawmode, then delivered.
   ASSERT_TRUE(testing::pump_until(step, [&] { return has(" < frame 583 "); })) << received;

@@ -18,6 +18,7 @@ namespace motwin::canopen {
 inline constexpr uint16_t kEmcyErrorReset = 0x0000;
 inline constexpr uint16_t kEmcyHeartbeat = 0x8130;
 inline constexpr uint16_t kEmcyCanOverflow = 0x8110;
+inline constexpr uint16_t kEmcyPdoParameter = 0x6320;  // RPDO value refused (manual table 365)
 
 // 1001 bits (table 11).
 inline constexpr uint8_t kErrorRegisterGeneric = 0x01;

@@ -22,6 +22,8 @@ PdoService::PdoService(ObjectDictionary& dictionary, board::CanController& can,
 void PdoService::reset() {
   for (ReceiveState& r : receive_) r = ReceiveState{};
   for (TransmitState& t : transmit_) t = TransmitState{};
+  for (ResolvedMapping& m : rpdo_resolved_) m.resolved = false;
+  for (ResolvedMapping& m : tpdo_resolved_) m.resolved = false;
 }
 
 void PdoService::enter_operational() {
@@ -34,22 +36,39 @@ void PdoService::enter_operational() {
   }
 }
 
-bool PdoService::mapped_length(const PdoMapping& mapping, bool receive, size_t& bytes) const {
-  bytes = 0;
-  if (mapping.count > kMaxPdoMappedObjects) return false;
-  for (uint8_t e = 0; e < mapping.count; ++e) {
+const PdoService::ResolvedMapping& PdoService::resolve(ResolvedMapping& cache, const PdoMapping& mapping,
+                                                       bool receive) {
+  // The module's mapping is checked against the copy at every use: a few word compares, and no
+  // notification to miss whichever way the mapping changed (SDO, restore, reset, a test).
+  const uint8_t count = mapping.count < kMaxPdoMappedObjects ? mapping.count : kMaxPdoMappedObjects;
+  bool same = cache.resolved && cache.count == mapping.count;
+  for (uint8_t e = 0; e < count && same; ++e) same = cache.entries[e] == mapping.entries[e];
+  if (same) return cache;
+
+  cache = ResolvedMapping{};
+  cache.resolved = true;
+  cache.count = mapping.count;
+  for (uint8_t e = 0; e < count; ++e) cache.entries[e] = mapping.entries[e];
+  if (mapping.count > kMaxPdoMappedObjects) return cache;  // inactive
+  size_t bytes = 0;
+  for (uint8_t e = 0; e < count; ++e) {
     const uint32_t entry = mapping.entries[e];
     const uint8_t bits = mapped_bits(entry);
-    if (bits == 0 || bits % 8 != 0) return false;
+    if (bits == 0 || bits % 8 != 0) return cache;
     if (!is_dummy_mapping(entry)) {
       ObjectRef ref;
-      if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return false;
-      if (receive ? !writable(ref.info->access) : !readable(ref.info->access)) return false;
-      if (type_size(ref.info->type) * 8u != bits) return false;
+      if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return cache;
+      if (receive ? !writable(ref.info->access) : !readable(ref.info->access)) return cache;
+      if (type_size(ref.info->type) * 8u != bits) return cache;
+      if (static_cast<uint64_t>(ref.row) > UINT32_MAX) return cache;  // not a row of any real table
+      cache.objects[e] = MappedObject{ref.info, static_cast<uint32_t>(ref.row), ref.index, ref.axis};
     }
     bytes += bits / 8u;
   }
-  return bytes <= 8;
+  if (bytes > 8) return cache;
+  cache.active = true;
+  cache.bytes = static_cast<uint8_t>(bytes);
+  return cache;
 }
 
 RpdoReception PdoService::on_frame(const can::CanFrame& frame) {
@@ -57,49 +76,51 @@ RpdoReception PdoService::on_frame(const can::CanFrame& frame) {
   for (size_t i = 0; i < rpdo_.size(); ++i) {
     const PdoCommunication& pdo = rpdo_[i];
     if (!pdo_valid(pdo) || (pdo.cob_id & 0x7FF) != frame.id) continue;
-    size_t bytes = 0;
-    if (!mapped_length(rpdo_mapping_[i], true, bytes)) return RpdoReception::kAccepted;  // inactive: ignored
-    if (frame.dlc < bytes) return RpdoReception::kTooShort;
+    const ResolvedMapping& mapping = resolve(rpdo_resolved_[i], rpdo_mapping_[i], true);
+    if (!mapping.active) return RpdoReception::kAccepted;  // inactive: ignored
+    if (frame.dlc < mapping.bytes) return RpdoReception::kTooShort;
     if (pdo_synchronous(pdo)) {
       ReceiveState& state = receive_[i];
       state.pending = true;
       state.dlc = frame.dlc;
       for (uint8_t b = 0; b < 8; ++b) state.data[b] = frame.data[b];
     } else {
-      write_mapped(rpdo_mapping_[i], frame.data);
+      write_mapped(mapping, frame.data);
     }
-    return frame.dlc > bytes ? RpdoReception::kTooLong : RpdoReception::kAccepted;
+    return frame.dlc > mapping.bytes ? RpdoReception::kTooLong : RpdoReception::kAccepted;
   }
   return RpdoReception::kNotPdo;
 }
 
-void PdoService::write_mapped(const PdoMapping& mapping, const uint8_t* data) {
+void PdoService::write_mapped(const ResolvedMapping& mapping, const uint8_t* data) {
   size_t offset = 0;
+  bool refused = false;
   for (uint8_t e = 0; e < mapping.count; ++e) {
-    const uint32_t entry = mapping.entries[e];
-    const size_t bytes = mapped_bits(entry) / 8u;
-    ObjectRef ref;
+    const size_t bytes = mapped_bits(mapping.entries[e]) / 8u;
+    const MappedObject& object = mapping.objects[e];
     // A value the object refuses (out of its range) is dropped; the other objects are written.
-    if (!is_dummy_mapping(entry) && dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) == SdoAbort::kNone) {
-      dictionary_.write(ref, data + offset, bytes);
+    if (object.info != nullptr) {
+      const ObjectRef ref{object.info, object.row, object.index, object.axis};
+      if (dictionary_.write(ref, data + offset, bytes) != SdoAbort::kNone) refused = true;
     }
     offset += bytes;
   }
+  ++rpdo_writes_;
+  if (refused) ++refused_writes_;
 }
 
-bool PdoService::sample(const PdoMapping& mapping, uint8_t (&out)[8], size_t& length) {
+bool PdoService::sample(size_t i, uint8_t (&out)[8], size_t& length) {
   length = 0;
-  size_t bytes = 0;
-  if (!mapped_length(mapping, false, bytes)) return false;
+  const ResolvedMapping& mapping = resolve(tpdo_resolved_[i], tpdo_mapping_[i], false);
+  if (!mapping.active) return false;
   for (uint8_t e = 0; e < mapping.count; ++e) {
-    const uint32_t entry = mapping.entries[e];
-    const size_t size = mapped_bits(entry) / 8u;
-    if (is_dummy_mapping(entry)) {
+    const size_t size = mapped_bits(mapping.entries[e]) / 8u;
+    const MappedObject& object = mapping.objects[e];
+    if (object.info == nullptr) {  // dummy
       for (size_t b = 0; b < size; ++b) out[length + b] = 0;
     } else {
-      ObjectRef ref;
       size_t read = 0;
-      if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return false;
+      const ObjectRef ref{object.info, object.row, object.index, object.axis};
       if (dictionary_.read(ref, out + length, 8 - length, read) != SdoAbort::kNone || read != size) return false;
     }
     length += size;
@@ -125,7 +146,11 @@ void PdoService::on_sync() {
     ReceiveState& state = receive_[i];
     if (!state.pending) continue;
     state.pending = false;
-    if (pdo_valid(rpdo_[i]) && pdo_synchronous(rpdo_[i])) write_mapped(rpdo_mapping_[i], state.data);
+    if (!pdo_valid(rpdo_[i]) || !pdo_synchronous(rpdo_[i])) continue;
+    // The mapping of the SYNC's time; data kept for another mapping (remapped in between) that
+    // is too short for this one is dropped.
+    const ResolvedMapping& mapping = resolve(rpdo_resolved_[i], rpdo_mapping_[i], true);
+    if (mapping.active && state.dlc >= mapping.bytes) write_mapped(mapping, state.data);
   }
   for (size_t i = 0; i < tpdo_.size(); ++i) {
     const PdoCommunication& pdo = tpdo_[i];
@@ -135,7 +160,7 @@ void PdoService::on_sync() {
     state.sync_count = 0;
     uint8_t data[8] = {};
     size_t length = 0;
-    if (sample(tpdo_mapping_[i], data, length)) transmit(i, data, length);
+    if (sample(i, data, length)) transmit(i, data, length);
   }
 }
 
@@ -155,7 +180,7 @@ void PdoService::process(uint32_t elapsed_us) {
     }
     uint8_t data[8] = {};
     size_t length = 0;
-    if (!sample(tpdo_mapping_[i], data, length)) continue;
+    if (!sample(i, data, length)) continue;
     bool changed = !state.sent || length != state.length;
     for (size_t b = 0; b < length && !changed; ++b) changed = data[b] != state.last[b];
     if (changed) state.due = true;

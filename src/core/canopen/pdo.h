@@ -2,7 +2,10 @@
 // every mapped object through the object dictionary, transmit PDOs read them. The communication
 // and mapping parameters (1400.., 1600.., 1800.., 1A00..) are the module's data, written by SDO
 // with the checks of its object table; this service only reads them, every time it uses them, so
-// a reconfiguration applies at once.
+// a reconfiguration applies at once. Each mapping is resolved to its objects (ObjectRef) once and
+// the references kept with a copy of the entries they came from; a use that finds the module's
+// mapping different from that copy resolves it again (docs/canopen.md, "How mappings are
+// resolved"); the per-frame work is then a compare and the object accesses themselves.
 //
 // Receive PDO (valid COB-ID, frame with that identifier, NMT operational):
 //   transmission type 254/255   the mapped objects are written at once
@@ -15,8 +18,8 @@
 //   1..240    sent at every n-th SYNC (the count starts at entering operational)
 // Mapping entries name `index << 16 | sub << 8 | bits`; dummy entries (index 0002..0007, sub 0)
 // are skipped by RPDOs and sent as zeros by TPDOs (as CANopenNode). A PDO whose mapping names an
-// object the dictionary cannot read (TPDO) or write (RPDO), such as the CiA-402 defaults before
-// the drive exists, is inactive: never sent, its frames ignored.
+// object the dictionary does not have or cannot read (TPDO) or write (RPDO) is inactive: never
+// sent, its frames ignored, until its mapping changes.
 #pragma once
 
 #include <cstddef>
@@ -78,7 +81,7 @@ class PdoService {
              std::span<const PdoMapping> rpdo_mapping, std::span<const PdoCommunication> tpdo,
              std::span<const PdoMapping> tpdo_mapping);
 
-  // Back to the state after a reset: nothing pending, timers stopped.
+  // Back to the state after a reset: nothing pending, timers stopped, mappings resolved afresh.
   void reset();
   // Entering NMT operational: every active event-driven TPDO is due, the SYNC counts start over.
   void enter_operational();
@@ -92,6 +95,11 @@ class PdoService {
   void process(uint32_t elapsed_us);
 
   uint64_t transmitted() const { return transmitted_; }
+  // RPDO writes of which the dictionary refused at least one value (out of range, not allowed in
+  // the present state): the other mapped values were written. The module reports them (EMCY 6320).
+  uint64_t refused_writes() const { return refused_writes_; }
+  // RPDO writes made (received frames of event-driven RPDOs, synchronous ones at their SYNC).
+  uint64_t rpdo_writes() const { return rpdo_writes_; }
 
  private:
   struct ReceiveState {
@@ -109,11 +117,29 @@ class PdoService {
     uint8_t last[8] = {};
   };
 
-  // Total mapped bytes; false when an entry is not byte-sized or its object is unusable.
-  bool mapped_length(const PdoMapping& mapping, bool receive, size_t& bytes) const;
-  void write_mapped(const PdoMapping& mapping, const uint8_t* data);
-  // Reads the mapped objects into `out`; false when the PDO is inactive.
-  bool sample(const PdoMapping& mapping, uint8_t (&out)[8], size_t& length);
+  // A mapping resolved to the dictionary's objects. Valid while `entries[0..count)` equal the
+  // module's mapping: the dictionary's find() gives the same object for an index/sub-index for
+  // its lifetime (a TableDictionary's rows are constant).
+  struct MappedObject {
+    const EntryInfo* info = nullptr;  // nullptr: a dummy entry
+    uint32_t row = 0;
+    uint16_t index = 0;
+    uint8_t axis = 0;
+  };
+  struct ResolvedMapping {
+    bool resolved = false;  // false: resolve before use
+    bool active = false;    // every entry byte-sized and usable, at most 8 bytes in all
+    uint8_t count = 0;
+    uint8_t bytes = 0;
+    uint32_t entries[kMaxPdoMappedObjects] = {};
+    MappedObject objects[kMaxPdoMappedObjects] = {};
+  };
+
+  // The resolution of `mapping` kept in `cache`, redone when the mapping differs from it.
+  const ResolvedMapping& resolve(ResolvedMapping& cache, const PdoMapping& mapping, bool receive);
+  void write_mapped(const ResolvedMapping& mapping, const uint8_t* data);
+  // Reads the mapped objects of TPDO `i` into `out`; false when the PDO is inactive.
+  bool sample(size_t i, uint8_t (&out)[8], size_t& length);
   void transmit(size_t i, const uint8_t* data, size_t length);
 
   ObjectDictionary& dictionary_;
@@ -124,7 +150,11 @@ class PdoService {
   std::span<const PdoMapping> tpdo_mapping_;
   ReceiveState receive_[kMaxPdos] = {};
   TransmitState transmit_[kMaxPdos] = {};
+  ResolvedMapping rpdo_resolved_[kMaxPdos] = {};
+  ResolvedMapping tpdo_resolved_[kMaxPdos] = {};
   uint64_t transmitted_ = 0;
+  uint64_t refused_writes_ = 0;
+  uint64_t rpdo_writes_ = 0;
 };
 
 }  // namespace motwin::canopen
