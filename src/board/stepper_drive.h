@@ -27,7 +27,26 @@ struct StepperFeedback {
   uint8_t switches = 0;
   // Motor supply voltage, mV.
   int32_t supply_millivolt = 24000;
+  // What a TMC driver chip measures and flags (TMCM-3216; the TMCM-142 leaves them at 0).
+  // StallGuard2 result SG_RESULT 0..1023 (high: light load, 0: at the torque limit), updated once
+  // per full step and meaningless at standstill; StallGuard4 result SG4_RESULT 0..510 (StealthChop).
+  uint16_t stallguard2_result = 0;
+  uint16_t stallguard4_result = 0;
+  // Counts every new StallGuard result (wrapping): a change is the "new measurement" edge.
+  uint32_t stallguard_measurements = 0;
+  // DRV_STATUS error bits (kDriver* below), as the TMCM-3216 shows them in object 2102.
+  uint8_t driver_status = 0;
 };
+
+// feedback.driver_status bits (TMCM-3216 manual table 159).
+inline constexpr uint8_t kDriverOvercurrentA = 1u << 0;     // short on bridge A
+inline constexpr uint8_t kDriverOvercurrentB = 1u << 1;     // short on bridge B
+inline constexpr uint8_t kDriverOpenLoadA = 1u << 2;
+inline constexpr uint8_t kDriverOpenLoadB = 1u << 3;
+inline constexpr uint8_t kDriverOvercurrentHighSide = 1u << 4;
+inline constexpr uint8_t kDriverUndervoltage = 1u << 5;
+inline constexpr uint8_t kDriverTemperatureWarning = 1u << 6;
+inline constexpr uint8_t kDriverOvertemperature = 1u << 7;
 
 // Applied from the next tick on.
 struct StepperDrive {
@@ -40,6 +59,16 @@ struct StepperDrive {
   // (peak). Coil A follows the cosine, coil B the sine of the electrical angle.
   int32_t coil_a_ma = 0;
   int32_t coil_b_ma = 0;
+  // Driver chip settings the simulated measurements depend on (TMCM-3216; the TMCM-142 leaves
+  // them at their defaults): StealthChop instead of SpreadCycle, StallGuard2 threshold SGT
+  // (209E) and filter (209D), StallGuard4 filter (20A9) and angle offset (20AA), and the polarity
+  // the encoder interface expects of the N channel (200B sub 1: true = active low).
+  bool stealth_chop = false;
+  int8_t stallguard2_threshold = 0;
+  bool stallguard2_filter = false;
+  bool stallguard4_filter = false;
+  bool stallguard4_angle_offset = false;
+  bool encoder_index_active_low = false;
 };
 
 struct StepperPowerStage {

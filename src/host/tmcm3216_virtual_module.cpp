@@ -2,18 +2,26 @@
 
 #include <cstdlib>
 
+#include "sim/stepper_motor_selection.h"
+
 namespace motwin::host {
 
 EepromImageIdentity Tmcm3216VirtualModule::eeprom_identity() {
   return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, Device::kNvmSize};
 }
 
-std::span<const sim::SignalInfo> Tmcm3216VirtualModule::signal_table() { return {}; }
+std::span<const sim::SignalInfo> Tmcm3216VirtualModule::signal_table() { return sim::Tmcm3216SimBoard::signal_table(); }
 
 MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   MakeModuleResult result;
   if (options.node_id > 127) {
     result.error = "node ID " + std::to_string(options.node_id) + " is out of range (1..127)";
+    return result;
+  }
+  // The motor is checked before any file is touched.
+  sim::StepperMotorChoice motor = sim::resolve_stepper_motor(options.motor);
+  if (!motor.error.empty()) {
+    result.error = motor.error;
     return result;
   }
   std::unique_ptr<Tmcm3216VirtualModule> module(new Tmcm3216VirtualModule());
@@ -34,8 +42,12 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
   config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
+  module->board_ = motor.motor ? std::make_unique<sim::Tmcm3216SimBoard>(*motor.motor)
+                               : std::make_unique<sim::Tmcm3216SimBoard>();
+  for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
+  module->board_->before_tick();
   board::CanController& controller = *module;  // private base: reachable here only
-  module->device_ = std::make_unique<Device>(*module->nvm_, controller, config);
+  module->device_ = std::make_unique<Device>(*module->nvm_, controller, module->board_->board(), config);
   // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a
   // master joins later. Masters send an NMT reset to see one (docs/canopen.md).
   module->device_->power_up();
@@ -48,10 +60,18 @@ Tmcm3216VirtualModule::~Tmcm3216VirtualModule() { disconnect(); }
 tmcl::TmclEngine& Tmcm3216VirtualModule::engine() { std::abort(); }
 
 void Tmcm3216VirtualModule::run_ticks(uint64_t count) {
+  Device& device = *device_;
+  sim::Tmcm3216SimBoard& sim_board = *board_;
+  constexpr double kTickS = modules::tmcm3216::kTickUs * 1e-6;
   for (uint64_t i = 0; i < count; ++i) {
-    device_->tick();
+    // Output changes are stamped with the start of the tick that made them.
+    sim_board.set_sim_time_us(tick_count_ * modules::tmcm3216::kTickUs);
+    sim_board.before_tick();
+    device.tick();
+    sim_board.after_tick(kTickS);
     ++tick_count_;
   }
+  sim_board.set_sim_time_us(tick_count_ * modules::tmcm3216::kTickUs);
 }
 
 std::string Tmcm3216VirtualModule::nvm_location() const {
@@ -80,6 +100,20 @@ void Tmcm3216VirtualModule::on_frame(const can::CanFrame& frame, uint64_t /*time
 bool Tmcm3216VirtualModule::transmit(const can::CanFrame& frame) {
   if (bus_ != nullptr) bus_->send(bus_id_, frame);
   return true;
+}
+
+board::CanControllerStatus Tmcm3216VirtualModule::status() const {
+  board::CanControllerStatus status;
+  const CanNodeBusStats* node = bus_ != nullptr ? bus_->node_stats(bus_id_) : nullptr;
+  if (node == nullptr) return status;  // on no bus: nothing to go wrong
+  const bool bus_off = node->error_state == CanErrorState::kBusOff;
+  status.error_state = bus_off ? board::CanErrorState::kBusOff
+                       : node->error_state == CanErrorState::kErrorPassive ? board::CanErrorState::kErrorPassive
+                                                                             : board::CanErrorState::kErrorActive;
+  status.warning = node->warning();
+  // The bus counts the times the node went bus-off; all but a bus-off still lasting have ended.
+  status.bus_off_recoveries = static_cast<uint32_t>(node->bus_off_count - (bus_off ? 1 : 0));
+  return status;
 }
 
 }  // namespace motwin::host

@@ -1,6 +1,8 @@
 // The TMCM-3216 (CANopen firmware V1.04) as a virtual module: the module profile with its CAN
-// controller on a virtual bus (host/can_bus.h) and its NVM image in a file or in memory. It has
-// no TMCL interface and, until the CiA-402 drive issue, no motors or I/O signals.
+// controller on a virtual bus (host/can_bus.h), its NVM image in a file or in memory, and the
+// simulated board (sim/tmcm3216_sim_board.h: three steppers, their sensors, the I/O). Each tick:
+// the board senses, the firmware ticks, the motors advance by Device's tick. It has no TMCL
+// interface.
 #pragma once
 
 #include <memory>
@@ -14,6 +16,7 @@
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
 #include "sim/signals.h"
+#include "sim/tmcm3216_sim_board.h"
 
 namespace motwin::host {
 
@@ -41,21 +44,28 @@ class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, pri
   uint64_t tick_count() const override { return tick_count_; }
   board::NonVolatileMemory& nvm() override { return *nvm_; }
   std::string nvm_location() const override;
-  sim::SignalBoard& signals() override { return signals_; }
+  sim::SignalBoard& signals() override { return *board_; }
 
   // CanBusNode.
   void connect(CanBus& bus) override;
   void disconnect() override;
   void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override;
+  // The active bit rate (2707: 2704 at the last reset, or an LSS-activated one): the bus cuts
+  // the node off while it differs from the bus's (host/can_bus.h).
+  uint32_t controller_bit_rate() override { return uint32_t{device_->bit_rate_kbit()} * 1000u; }
 
   Device& device() { return *device_; }
+  sim::Tmcm3216SimBoard& board() { return *board_; }
 
  private:
   Tmcm3216VirtualModule() = default;
-  // board::CanController: what the firmware transmits goes onto the bus.
+  // board::CanController: what the firmware transmits goes onto the bus; its fault confinement
+  // is the bus's view of the node (CanBus::node_stats: error counters, bus-off and recovery).
   bool transmit(const can::CanFrame& frame) override;
+  board::CanControllerStatus status() const override;
 
-  NoSignalBoard signals_;  // no inputs or outputs yet
+  // Before device_: the device keeps a reference to its board seam.
+  std::unique_ptr<sim::Tmcm3216SimBoard> board_;
   std::unique_ptr<EepromFile> eeprom_file_;
   std::unique_ptr<MemoryImage> memory_image_;
   board::NonVolatileMemory* nvm_ = nullptr;

@@ -31,7 +31,7 @@ TEST(Tmcm3216Objects, table_has_no_duplicate_entries_and_sane_ranges) {
 
 TEST(Tmcm3216Objects, communication_area_defaults_of_chapter_3) {
   Tmcm3216Rig rig;
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);
   EXPECT_EQ(rig.read_u32(0x1001, 0) & 0xFF, 0u);
   EXPECT_EQ(rig.read_u32(0x1005, 0), 0x80u);
   EXPECT_EQ(rig.read_u32(0x1014, 0), 0x81u);
@@ -273,7 +273,7 @@ TEST(Tmcm3216Objects, receive_queue_overflow_drops_frames_and_keeps_working) {
   for (size_t i = 0; i < Tmcm3216::kReceiveQueueLength + 5; ++i) rig.device->receive(frame_of(0x123, {1, 2}));
   EXPECT_EQ(rig.device->dropped_frames(), 5u);
   rig.device->process(0);
-  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFC0192u);
+  EXPECT_EQ(rig.read_u32(0x1000, 0), 0xFFFF0192u);
 }
 
 }  // namespace

@@ -16,8 +16,13 @@ constexpr uint8_t kAllAxes = (1u << kAxisCount) - 1;
 void Tmcm3216::format_factory_image(uint8_t* image, size_t size) { canopen::StorageImage::format(image, size); }
 
 Tmcm3216::Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, const Tmcm3216Config& config)
+    : Tmcm3216(nvm, can, own_board_, config) {}
+
+Tmcm3216::Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, board::Tmcm3216Board& board,
+                   const Tmcm3216Config& config)
     : nvm_(nvm),
       can_(can),
+      board_(board),
       config_(config),
       dictionary_(*this, object_table(), kAxisCount),
       nmt_(can),
@@ -27,7 +32,9 @@ Tmcm3216::Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, con
       pdos_(dictionary_, can, communication_.rpdo, communication_.rpdo_mapping, communication_.tpdo,
             communication_.tpdo_mapping),
       lss_(can, *this),
-      storage_(dictionary_, nvm, storage_scratch_.data(), storage_scratch_.size()) {}
+      storage_(dictionary_, nvm, storage_scratch_.data(), storage_scratch_.size()) {
+  for (cia402::AxisDrive& drive : drives_) drive.set_clock_hz(kDriverClockHz);
+}
 
 canopen::LssIdentity Tmcm3216::identity() const {
   return canopen::LssIdentity{kVendorId, kProductCode, kRevisionNumber, config_.serial_number};
@@ -38,6 +45,8 @@ void Tmcm3216::power_up() {
   receive_count_ = 0;
   reported_dropped_frames_ = dropped_frames_;
   lss_bit_rate_kbit_ = 0;
+  // Bus-off recoveries before this power-up are not this run's to report.
+  bus_off_recoveries_ = can_.status().bus_off_recoveries;
   lss_.power_up(identity(), canopen::kLssUnconfiguredNodeId, 0);  // forget an LSS-configured node ID
   reset_node();
   lss_.power_up(identity(), node_id_, bit_rate_kbit_);
@@ -49,6 +58,7 @@ void Tmcm3216::reset_node() {
   application.axis_mask = kAllAxes;
   storage_.load(application);
   error_register_ = 0;
+  reset_axes();
   reset_communication();
 }
 
@@ -57,6 +67,9 @@ void Tmcm3216::reset_communication() {
   sdo_.reset();
   emergency_.reset();
   error_register_ = 0;
+  parameter_error_ = false;
+  reported_refused_writes_ = pdos_.refused_writes();
+  reported_rpdo_writes_ = pdos_.rpdo_writes();
   // Node ID and bit rate first: the "$NODEID+" defaults of the communication objects use it.
   StorageSelection node;
   node.node_settings = true;
@@ -73,6 +86,7 @@ void Tmcm3216::reset_communication() {
   sdo_.set_node_id(node_id_);
   lss_.set_active_node_id(node_id_);
   communication_errors_ = 0;
+  can_controller_error_ = CanControllerError::kNone;  // a state that lasts is reported anew
   StorageSelection communication;
   communication.communication = true;
   storage_.load(communication);  // 1005..1017 reach sync_, emergency_, heartbeat_consumer_, nmt_ by their bindings
@@ -105,6 +119,7 @@ void Tmcm3216::process(uint32_t elapsed_us) {
   }
   if (!configured()) return;
   check_receive_overrun(elapsed_us);
+  if (elapsed_us > 0) check_can_controller();
   run_nmt(elapsed_us);
   run_heartbeat_consumer(elapsed_us);
   const NmtState state = nmt_.state();
@@ -118,14 +133,19 @@ void Tmcm3216::process(uint32_t elapsed_us) {
 
 void Tmcm3216::run_sync(uint32_t elapsed_us) {
   // The node's own SYNC does not come back from the bus: it is acted on here.
-  if (sync_.process(elapsed_us, true) && nmt_.state() == NmtState::kOperational) pdos_.on_sync();
+  if (sync_.process(elapsed_us, true)) {
+    if (nmt_.state() == NmtState::kOperational) {
+      pdos_.on_sync();
+      check_rpdo_values();
+    }
+    sync_axes();
+  }
 }
 
 void Tmcm3216::check_receive_overrun(uint32_t elapsed_us) {
   // Frames lost in a full receive queue: EMCY 8110 once; cleared after a tick without losses.
   if (dropped_frames_ != reported_dropped_frames_) {
     reported_dropped_frames_ = dropped_frames_;
-  lss_bit_rate_kbit_ = 0;
     raise_error(kCommErrorCanOverrun, canopen::kEmcyCanOverflow);
   } else if (elapsed_us > 0) {
     clear_error(kCommErrorCanOverrun);
@@ -133,12 +153,17 @@ void Tmcm3216::check_receive_overrun(uint32_t elapsed_us) {
 }
 
 void Tmcm3216::raise_error(uint8_t error, uint16_t emcy_code) {
+  if ((communication_errors_ & error) != 0) return;
+  report_error(error, emcy_code);
+}
+
+void Tmcm3216::report_error(uint8_t error, uint16_t emcy_code) {
   // Manual table 365: byte 2 is the motor, 255 for the communication errors.
   static constexpr uint8_t kNoMotor[5] = {0, 255, 0, 0, 0};
-  if ((communication_errors_ & error) != 0) return;
   communication_errors_ |= error;
   error_register_ |= canopen::kErrorRegisterCommunication | canopen::kErrorRegisterGeneric;
-  emergency_.report(emcy_code, error_register_, kNoMotor);
+  // The whole 1001 as this report leaves it (the axes' bits too).
+  emergency_.report(emcy_code, error_register(), kNoMotor);
 }
 
 void Tmcm3216::clear_error(uint8_t error) {
@@ -149,7 +174,49 @@ void Tmcm3216::clear_error(uint8_t error) {
     error_register_ = static_cast<uint8_t>(error_register_ & ~canopen::kErrorRegisterCommunication);
     if (error_register_ == canopen::kErrorRegisterGeneric) error_register_ = 0;
   }
-  emergency_.report(canopen::kEmcyErrorReset, error_register_, kNoMotor);
+  emergency_.report(canopen::kEmcyErrorReset, error_register(), kNoMotor);
+}
+
+void Tmcm3216::check_can_controller() {
+  const board::CanControllerStatus status = can_.status();
+  // A count that went down is another controller (the node moved to another bus): no event.
+  const bool recovered = status.bus_off_recoveries > bus_off_recoveries_;
+  bus_off_recoveries_ = status.bus_off_recoveries;
+  const bool bus_off = status.error_state == board::CanErrorState::kBusOff;
+  // Table 365, 8140: at bus-off "the drive has been stopped and disabled": the master has lost
+  // the axes, so each running one takes its fault reaction (605E ramp, then FAULT), as with
+  // NMT stopped. Also when a bus-off began and ended between two polls.
+  if (bus_off || recovered) {
+    for (cia402::AxisDrive& drive : drives_) {
+      if (drive.pds().power_enabled()) drive.external_fault();
+    }
+  }
+  if (recovered) {
+    // Bus-on again: 8140 is the controller's first message (a bus-off node sends nothing).
+    can_controller_error_ = CanControllerError::kRecovered;
+    report_error(kCommErrorCanController, kEmcyCanBusOffRecovered);
+    return;
+  }
+  switch (status.error_state) {
+    case board::CanErrorState::kBusOff:
+      // Nothing reaches the bus: the error stays set (1001 bit 4), silently; 8140 follows.
+      can_controller_error_ = CanControllerError::kBusOff;
+      communication_errors_ |= kCommErrorCanController;
+      error_register_ |= canopen::kErrorRegisterCommunication | canopen::kErrorRegisterGeneric;
+      return;
+    case board::CanErrorState::kErrorPassive:
+      // An error-passive node still transmits (with a longer pause): 8120 goes out now.
+      if (can_controller_error_ != CanControllerError::kErrorPassive) {
+        can_controller_error_ = CanControllerError::kErrorPassive;
+        report_error(kCommErrorCanController, kEmcyCanErrorPassive);
+      }
+      return;
+    case board::CanErrorState::kErrorActive:
+      // Error-active again, or one service tick after 8140: 0000 (like 8110).
+      can_controller_error_ = CanControllerError::kNone;
+      clear_error(kCommErrorCanController);
+      return;
+  }
 }
 
 void Tmcm3216::handle_pdo(const can::CanFrame& frame) {
@@ -158,11 +225,35 @@ void Tmcm3216::handle_pdo(const can::CanFrame& frame) {
     case canopen::RpdoReception::kAccepted:
       clear_error(kCommErrorPdoLength);
       clear_error(kCommErrorPdoLengthExceeded);
+      check_rpdo_values();
       return;
     case canopen::RpdoReception::kTooShort: raise_error(kCommErrorPdoLength, canopen::kEmcyPdoLength); return;
     case canopen::RpdoReception::kTooLong:
       raise_error(kCommErrorPdoLengthExceeded, canopen::kEmcyPdoLengthExceeded);
+      check_rpdo_values();
       return;
+  }
+}
+
+void Tmcm3216::check_rpdo_values() {
+  // Manual table 365, 6320 "parameter error": the data in a received PDO is wrong or cannot be
+  // accepted in the drive's present state; byte 2 = 255 (no motor). Like 8210: once per episode,
+  // 0000 when an RPDO is written whole again. A synchronous RPDO is judged at its SYNC.
+  static constexpr uint8_t kNoMotor[5] = {0, 255, 0, 0, 0};
+  const uint64_t refused = pdos_.refused_writes();
+  const uint64_t written = pdos_.rpdo_writes();
+  const bool any_refused = refused != reported_refused_writes_;
+  const bool any_written = written != reported_rpdo_writes_;
+  reported_refused_writes_ = refused;
+  reported_rpdo_writes_ = written;
+  if (any_refused) {
+    if (!parameter_error_) {
+      parameter_error_ = true;
+      emergency_.report(canopen::kEmcyPdoParameter, error_register(), kNoMotor);
+    }
+  } else if (any_written && parameter_error_) {
+    parameter_error_ = false;
+    emergency_.report(canopen::kEmcyErrorReset, error_register(), kNoMotor);
   }
 }
 
@@ -221,7 +312,11 @@ void Tmcm3216::handle_frame(const can::CanFrame& frame) {
   }
   const NmtState state = nmt_.state();
   if (sync_.is_sync(frame)) {
-    if (state == NmtState::kOperational) pdos_.on_sync();
+    if (state == NmtState::kOperational) {
+      pdos_.on_sync();
+      check_rpdo_values();
+    }
+    if (state == NmtState::kOperational || state == NmtState::kPreOperational) sync_axes();
     return;
   }
   if (frame.id == sdo_.request_cob_id() && (state == NmtState::kPreOperational || state == NmtState::kOperational)) {
@@ -285,6 +380,108 @@ SdoAbort Tmcm3216::store_node_settings(uint32_t signature) {
   StorageSelection selection;
   selection.node_settings = true;
   return storage_.save(selection);
+}
+
+// --- The drive -----------------------------------------------------------------------------------
+
+void Tmcm3216::tick() {
+  service_elapsed_us_ += kTickUs;
+  if (receive_count_ > 0 || service_elapsed_us_ >= kServicePeriodUs) {
+    const uint32_t elapsed = service_elapsed_us_;
+    service_elapsed_us_ = 0;
+    process(elapsed);
+  }
+  run_axes(kTickUs);
+}
+
+void Tmcm3216::reset_axes() {
+  for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
+    steppers_[axis].reset();
+    drives_[axis].reset(0);
+  }
+  emergencies_.reset();
+}
+
+void Tmcm3216::sync_axes() {
+  for (cia402::AxisDrive& drive : drives_) drive.on_sync();
+}
+
+uint8_t Tmcm3216::axis_error_register() const {
+  for (const cia402::AxisDrive& drive : drives_) {
+    const cia402::PdsState state = drive.state();
+    if (state == cia402::PdsState::kFault || state == cia402::PdsState::kFaultReactionActive) {
+      return kErrorRegisterAxisFault;  // generic + device profile (table 11)
+    }
+  }
+  return 0;
+}
+
+void Tmcm3216::run_axes(uint32_t dt_us) {
+  general_io_.sample(board_.io);
+  bool brake_control[kAxisCount] = {};
+  uint8_t brake_duty[kAxisCount] = {};
+  for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
+    run_axis(axis, dt_us);
+    brake_control[axis] = steppers_[axis].brake_control();
+    brake_duty[axis] = steppers_[axis].brake_duty();
+  }
+  general_io_.drive(board_.io, brake_control, brake_duty);
+}
+
+void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
+  cia402::AxisDrive& drive = drives_[axis];
+  Tmcm3216Stepper& stepper = steppers_[axis];
+  // NMT stopped takes the drive function away from a running axis: FAULT (issue 7).
+  if (configured() && nmt_.state() == NmtState::kStopped && drive.state() == cia402::PdsState::kOperationEnabled) {
+    drive.external_fault();
+  }
+  // The stepper's readings of the previous tick (switches, encoder, stall, driver flags).
+  cia402::AxisInputs inputs;
+  const SwitchState switches = stepper.switches();
+  inputs.encoder_position_usteps = stepper.encoder_position();
+  inputs.left_limit = switches.left;
+  inputs.right_limit = switches.right;
+  inputs.home_switch = switches.home;
+  inputs.index_events = stepper.index_events();
+  inputs.index_position_usteps = stepper.index_position();
+  // The module always has its encoder interface; without pulses an index search ends after two
+  // revolutions (kIndexNotFound). The stepper's index_available() only says a pulse was seen.
+  inputs.index_available = true;
+  inputs.stall = stepper.stall_detected();
+  inputs.stall_enters_fault = stepper.stall_enters_fault();
+  inputs.driver_errors = stepper.driver_error_flags();
+  inputs.ready = stepper.ready();
+  // Table 365 on the same readings and PDS state the drive sees in this step (after it, a
+  // standing axis the drive has just faulted has its power stage off: a driver fault would pass
+  // for a warning). The monitor is the single sender of the axis's EMCYs.
+  const uint8_t others = static_cast<uint8_t>(error_register_ | axis_error_register());  // 1001 besides the monitor's
+  if (emergencies_.update(axis, conditions_of(stepper, drive), emergency_, others).fault) drive.external_fault();
+  drive.step(inputs, dt_us);
+  const cia402::AxisDemand& demand = drive.demand();
+  if (demand.clear_stall) stepper.clear_stall();
+  int32_t position = 0;
+  if (drive.take_position_assignment(position)) stepper.set_actual_position(position);
+  drive.set_usteps_per_revolution(stepper.microsteps_per_full_step() * stepper.objects.full_steps_per_revolution);
+  // Profile objects the stepper needs (608F sub 1 is bound to the stepper directly).
+  stepper.objects.encoder_used = drive.objects.sensor_selection == 0;
+  stepper.objects.velocity_in_chip_units = drive.objects.velocity_dimension == cia402::kVelocityDimensionInternal;
+  StepperDemand stepper_demand;
+  stepper_demand.position_usteps = demand.position_usteps;
+  stepper_demand.velocity_pps = demand.velocity_pps;
+  stepper_demand.power_enabled = demand.power_enabled;
+  stepper_demand.brake_released_request = demand.brake_released_request;
+  stepper_demand.switch_on_disabled = demand.switch_on_disabled;
+  stepper.tick(board_.axes[axis], stepper_demand, dt_us);
+  // 200B sub 3: the encoder's position becomes the actual position at switch-on.
+  if (stepper.take_position_initialization(position)) drive.assign_position(position);
+  // The drive's own queue only tells of a fault reset (transition 15): the monitor sends 0000, or
+  // the EMCY of a fault still present, and then the axis goes back to FAULT.
+  cia402::AxisEmergency emcy;
+  while (drive.take_emergency(emcy)) {
+    if (emcy.code != cia402::kEmcyFaultReset) continue;
+    const uint8_t now_others = static_cast<uint8_t>(error_register_ | axis_error_register());
+    if (!emergencies_.fault_reset(axis, emergency_, now_others)) drive.external_fault();
+  }
 }
 
 }  // namespace motwin::modules::tmcm3216

@@ -3,7 +3,8 @@
 // boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
 // memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour, RPDOs and
 // TPDOs with the manual's numbering and defaults, SYNC (consumer; producer as a Motwin extension)
-// and the LSS slave. The CiA-402 drive follows in its own issue.
+// and the LSS slave; and the three-axis CiA-402 drive (cia402::AxisDrive per axis) on the
+// stepper axes of its board (Tmcm3216Stepper, board/tmcm3216_board.h). docs/tmcm-3216-drive.md.
 #pragma once
 
 #include <array>
@@ -14,8 +15,11 @@
 
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
+#include "board/tmcm3216_board.h"
 #include "core/can/can_frame.h"
+#include "core/cia402/axis_drive.h"
 #include "core/canopen/emergency.h"
+#include "core/modules/tmcm3216/tmcm3216_emergencies.h"
 #include "core/canopen/heartbeat_consumer.h"
 #include "core/canopen/nmt.h"
 #include "core/canopen/lss_slave.h"
@@ -24,6 +28,8 @@
 #include "core/canopen/sdo_server.h"
 #include "core/canopen/storage.h"
 #include "core/canopen/sync.h"
+#include "core/modules/tmcm3216/tmcm3216_io.h"
+#include "core/modules/tmcm3216/tmcm3216_stepper.h"
 
 namespace motwin::modules::tmcm3216 {
 
@@ -32,9 +38,16 @@ inline constexpr uint8_t kPdosPerAxis = 4;       // RPDO/TPDO 1..4, 65..68, 129.
 inline constexpr uint8_t kMaxMappedObjects = 3;  // "dynamic mapping with max. three mapping entries"
 inline constexpr uint16_t kPdoAxisStride = 0x40; // 1400 -> 1440 -> 1480 (manual 3.1.15)
 inline constexpr size_t kPdoCount = kAxisCount * kPdosPerAxis;  // per direction; PDO K of axis n at n * 4 + K
-// The CANopen services run once per millisecond of simulated time (and at once whenever a frame
-// arrives, so that an SDO request is answered within the process() call that sees it).
-inline constexpr uint32_t kTickUs = 1000;
+// The motion tick (same as the TMCM-142): each tick the sim board senses, tick() runs the drives
+// and steppers, the plants advance kTickUs. The CANopen services keep their millisecond timers:
+// they run once per kServicePeriodUs of ticks (and at once whenever a frame arrives, so that an
+// SDO request is answered within the tick or process() call that sees it).
+inline constexpr uint32_t kTickUs = 50;
+inline constexpr uint32_t kServicePeriodUs = 1000;
+
+// EMCY codes of the CAN controller (table 365; additional byte 2 = 255).
+inline constexpr uint16_t kEmcyCanErrorPassive = 0x8120;
+inline constexpr uint16_t kEmcyCanBusOffRecovered = 0x8140;
 
 using PdoCommunication = canopen::PdoCommunication;
 using PdoMapping = canopen::PdoMapping;  // entries 1..kMaxMappedObjects used
@@ -77,9 +90,9 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr std::string_view kHardwareVersion = "1.00";      // 1009 (manual's example)
   static constexpr std::string_view kSoftwareVersion = "1.04";      // 100A: firmware V1.04
   static constexpr std::string_view kFirmwareVersion = "CANopen V1.04";
-  // 1000 as table 8 prints it. CiA-301's rule for multi-device modules would give 0xFFFF0192;
-  // the manual is what the real module reports (docs/canopen.md "Decisions").
-  static constexpr uint32_t kDeviceType = 0xFFFC'0192;
+  // 1000: CiA-301's value for a multi-device module (upper 16 bits FFFF), profile 402; table 8
+  // prints 0xFFFC0192 (docs/canopen.md "Decisions", issue 7). Each axis has its own 67FF.
+  static constexpr uint32_t kDeviceType = 0xFFFF'0192;
   static constexpr uint32_t kVendorId = 0x0000'0286;
   static constexpr uint32_t kProductCode = 3216;
   static constexpr uint32_t kRevisionNumber = 0x0001'0004;  // major << 16 | minor, "20003h for 2.3"
@@ -96,6 +109,9 @@ class Tmcm3216 final : private canopen::LssDevice {
   // An image with nothing stored: every object at its default.
   static void format_factory_image(uint8_t* image, size_t size);
 
+  Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, board::Tmcm3216Board& board,
+           const Tmcm3216Config& config = {});
+  // Without a board: the module on a board of its own with nothing attached (communication tests).
   Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, const Tmcm3216Config& config = {});
   Tmcm3216(const Tmcm3216&) = delete;
   Tmcm3216& operator=(const Tmcm3216&) = delete;
@@ -107,13 +123,19 @@ class Tmcm3216 final : private canopen::LssDevice {
   bool receive(const can::CanFrame& frame);
   // Handles the queued frames, then advances the services' timers by `elapsed_us`.
   void process(uint32_t elapsed_us);
-  void tick() { process(kTickUs); }
+  // One motion tick: queued frames, the services once per kServicePeriodUs, then every axis
+  // (drive, stepper) and the I/O against the board.
+  void tick();
 
   uint8_t node_id() const { return node_id_; }            // active (2708)
   uint16_t bit_rate_kbit() const { return bit_rate_kbit_; }  // active (2707)
   bool configured() const { return node_id_ >= 1 && node_id_ <= 127; }
   canopen::NmtState nmt_state() const { return nmt_.state(); }
-  uint8_t error_register() const { return error_register_; }
+  // 1001: communication bits, the FAULT bits of the axes, the active conditions of table 365.
+  uint8_t error_register() const {
+    const uint8_t parameter = parameter_error_ ? canopen::kErrorRegisterGeneric : 0;
+    return static_cast<uint8_t>(error_register_ | parameter | axis_error_register() | emergencies_.error_register());
+  }
   uint64_t dropped_frames() const { return dropped_frames_; }
   // Communication errors now active (kCommError* bits); 1001 bit 4 while any is.
   uint8_t communication_errors() const { return communication_errors_; }
@@ -121,6 +143,7 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr uint8_t kCommErrorCanOverrun = 0x02;
   static constexpr uint8_t kCommErrorPdoLength = 0x04;
   static constexpr uint8_t kCommErrorPdoLengthExceeded = 0x08;
+  static constexpr uint8_t kCommErrorCanController = 0x10;  // error-passive, bus-off, just recovered
 
   Dictionary& dictionary() { return dictionary_; }
   canopen::NmtSlave& nmt() { return nmt_; }
@@ -133,6 +156,11 @@ class Tmcm3216 final : private canopen::LssDevice {
   CommunicationConfig& communication() { return communication_; }
   NodeSettings& node_settings() { return node_settings_; }
   const Tmcm3216Config& config() const { return config_; }
+  cia402::AxisDrive& drive(uint8_t axis) { return drives_[axis]; }
+  Tmcm3216Stepper& stepper(uint8_t axis) { return steppers_[axis]; }
+  Tmcm3216GeneralIo& general_io() { return general_io_; }
+  const Tmcm3216Emergencies& emergencies() const { return emergencies_; }
+  board::Tmcm3216Board& board() { return board_; }
 
   // 1010 / 1011 / 2706 sub-index `sub` written with `signature`.
   canopen::SdoAbort store_parameters(uint8_t sub, uint32_t signature);
@@ -141,16 +169,31 @@ class Tmcm3216 final : private canopen::LssDevice {
 
  private:
   void reset_node();
+  void reset_axes();
+  void run_axes(uint32_t dt_us);
+  void run_axis(uint8_t axis, uint32_t dt_us);
+  // A SYNC seen or produced: csp/csv set-points of every axis (after the synchronous RPDOs).
+  void sync_axes();
+  // 1001 bits of the axes: generic + device profile while an axis is in FAULT (or reacting).
+  uint8_t axis_error_register() const;
   void reset_communication();
   void handle_frame(const can::CanFrame& frame);
   void run_nmt(uint32_t elapsed_us);
   void run_heartbeat_consumer(uint32_t elapsed_us);
   void run_sync(uint32_t elapsed_us);
   void handle_pdo(const can::CanFrame& frame);
+  // EMCY 6320 when RPDO writes since the last check had a value refused; 0000 when the next
+  // RPDO is written whole.
+  void check_rpdo_values();
   void check_receive_overrun(uint32_t elapsed_us);
+  // The CAN controller's fault confinement (board::CanController::status()), once per service
+  // tick: EMCY 8120 while error-passive, the running axes stopped at bus-off, 8140 once back.
+  void check_can_controller();
   // Sets / clears one kCommError* bit, with its EMCY (code, or 0000 when it clears).
   void raise_error(uint8_t error, uint16_t emcy_code);
   void clear_error(uint8_t error);
+  // Sets a kCommError* bit and sends `emcy_code` even if the bit was set already.
+  void report_error(uint8_t error, uint16_t emcy_code);
   canopen::LssIdentity identity() const;
   // canopen::LssDevice.
   bool lss_bit_rate_supported(uint16_t bit_rate_kbit) const override;
@@ -158,6 +201,8 @@ class Tmcm3216 final : private canopen::LssDevice {
 
   board::NonVolatileMemory& nvm_;
   board::CanController& can_;
+  board::Tmcm3216Board own_board_{};  // used by the constructor without a board
+  board::Tmcm3216Board& board_;
   Tmcm3216Config config_;
   CommunicationConfig communication_{};
   NodeSettings node_settings_{};
@@ -165,6 +210,15 @@ class Tmcm3216 final : private canopen::LssDevice {
   uint16_t bit_rate_kbit_ = 1000;
   uint16_t lss_bit_rate_kbit_ = 0;  // activated by LSS since power-up (0: none)
   uint8_t error_register_ = 0;
+  uint64_t reported_refused_writes_ = 0;
+  uint64_t reported_rpdo_writes_ = 0;
+  bool parameter_error_ = false;  // EMCY 6320 sent, not yet cleared
+  uint32_t service_elapsed_us_ = 0;
+
+  std::array<Tmcm3216Stepper, kAxisCount> steppers_{};
+  std::array<cia402::AxisDrive, kAxisCount> drives_{};
+  Tmcm3216GeneralIo general_io_{};
+  Tmcm3216Emergencies emergencies_{};  // table 365 per axis: the single sender of the axes' EMCYs
 
   Dictionary dictionary_;
   canopen::NmtSlave nmt_;
@@ -175,6 +229,10 @@ class Tmcm3216 final : private canopen::LssDevice {
   canopen::PdoService pdos_;
   canopen::LssSlave lss_;
   uint8_t communication_errors_ = 0;
+  // What kCommErrorCanController stands for now (the last state reported).
+  enum class CanControllerError : uint8_t { kNone, kErrorPassive, kBusOff, kRecovered };
+  CanControllerError can_controller_error_ = CanControllerError::kNone;
+  uint32_t bus_off_recoveries_ = 0;  // board::CanControllerStatus::bus_off_recoveries seen
   std::array<uint8_t, kNvmSize> storage_scratch_{};
   canopen::ObjectStorage<Tmcm3216> storage_;
 

@@ -1,9 +1,13 @@
-// The TMCM-3216 object dictionary as data: communication area (manual chapter 3, tables 7-47)
-// and the node ID / bit rate objects (4.2.62-4.2.66). One row per sub-index; rows with an axis
+// The TMCM-3216 object dictionary as data: communication area (manual chapter 3, tables 7-47),
+// the node ID / bit rate objects (4.2.62-4.2.66), the manufacturer objects of the stepper axes
+// and the I/O (tmcm3216_manufacturer_objects.h), the ramp and unit objects and the CiA-402 profile
+// area (tmcm3216_profile_objects.h). One row per sub-index; rows with an axis
 // stride exist once per motor (PDO parameters: + 0x40 per axis, manual 3.1.15-3.1.18).
 #include <array>
 
 #include "core/modules/tmcm3216/tmcm3216.h"
+#include "core/modules/tmcm3216/tmcm3216_manufacturer_objects.h"
+#include "core/modules/tmcm3216/tmcm3216_profile_objects.h"
 
 namespace motwin::modules::tmcm3216 {
 namespace {
@@ -384,7 +388,7 @@ constexpr Binding getter(int64_t (*get)(Tmcm3216&, uint8_t)) {
 
 // --- The table ------------------------------------------------------------------------------------
 
-constexpr size_t kCapacity = 160;
+constexpr size_t kCapacity = 360;
 
 struct Table {
   std::array<Row, kCapacity> rows{};
@@ -562,6 +566,11 @@ constexpr Table build_table() {
   // Read-only and live; its default is the node ID itself (EDS "$NODEID+0x0").
   t.add(plus_node_id(var(0x2708, "Node ID load", kUnsigned8, Access::kRo, 0, 255, 0,
                          getter([](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.node_id()); }))));
+  // The axes: manufacturer area (+ 0x200 per axis), I/O, CiA-402 profile area (+ 0x800).
+  add_stepper_rows<Tmcm3216>(t);
+  add_ramp_rows<Tmcm3216>(t);
+  add_io_rows<Tmcm3216>(t);
+  add_profile_rows<Tmcm3216>(t);
   return t;
 }
 

@@ -1,0 +1,225 @@
+// One CiA-402 axis of the TMCM-3216: the PDS state machine (power_drive_system.h), the modes of
+// operation and their dispatch (pp, pv, hm, csp, csv; 6060/6061), the EightPoint ramp that
+// produces the position demand (6062), the monitoring functions (position window, following
+// error, software limits, limit switches, stall) and the statusword. It is pure arithmetic: the
+// module hands in what the axis hardware saw this tick (AxisInputs) and passes the demand on to
+// the stepper (AxisDemand); emergencies are queued for the module to send with the axis number.
+//
+// Edges of the controlword (pp new set-point, hm start, fault reset) act when the controlword
+// is written, so that a statusword read right after the write already shows the
+// acknowledgement (python-canopen and ros2_canopen poll at once, notes/canopen.md).
+//
+// Internal units: microsteps, microsteps/s (pps), microsteps/s² (pps2); objects are converted
+// with UnitScale (208C/208E). See docs/tmcm-3216-drive.md for the behaviour in detail.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "core/cia402/homing.h"
+#include "core/cia402/power_drive_system.h"
+#include "core/cia402/profile_objects.h"
+#include "core/motion/eight_point_ramp.h"
+
+namespace motwin::cia402 {
+
+// EMCY codes the drive produces (manual table 365); additional byte 1 is `sub`.
+inline constexpr uint16_t kEmcyFaultReset = 0x0000;
+inline constexpr uint16_t kEmcyOpenLoad = 0x1000;          // sub 1 bridge A, 2 bridge B
+inline constexpr uint16_t kEmcyOvercurrentHighSide = 0x2310;
+inline constexpr uint16_t kEmcyOvercurrentB = 0x2311;
+inline constexpr uint16_t kEmcyOvercurrentA = 0x2312;
+inline constexpr uint16_t kEmcyStall = 0x3230;
+inline constexpr uint16_t kEmcyOvertemperature = 0x4310;  // sub 0 error, 1 pre-warning
+inline constexpr uint16_t kEmcyFollowingError = 0x8611;
+inline constexpr uint16_t kEmcyUndervoltage = 0xFF00;
+inline constexpr uint16_t kEmcyLimit = 0xFF01;  // sub 1/2 positive/negative software limit, 3/4 switch
+
+// Driver error bits as the stepper reports them (board::kDriver*, 2102).
+inline constexpr uint8_t kDriverOvercurrentA = 1u << 0;
+inline constexpr uint8_t kDriverOvercurrentB = 1u << 1;
+inline constexpr uint8_t kDriverOpenLoadA = 1u << 2;
+inline constexpr uint8_t kDriverOpenLoadB = 1u << 3;
+inline constexpr uint8_t kDriverOvercurrentHighSide = 1u << 4;
+inline constexpr uint8_t kDriverUndervoltage = 1u << 5;
+inline constexpr uint8_t kDriverTemperatureWarning = 1u << 6;
+inline constexpr uint8_t kDriverOvertemperature = 1u << 7;
+
+struct AxisEmergency {
+  uint16_t code = 0;
+  uint8_t sub = 0;  // additional byte 1
+};
+
+// What the axis hardware shows this tick.
+struct AxisInputs {
+  int32_t encoder_position_usteps = 0;  // scaled to microsteps (608F); used when 606A = 0
+  bool left_limit = false;              // processed levels (2005 disable/invert applied)
+  bool right_limit = false;
+  bool home_switch = false;
+  uint32_t index_events = 0;
+  int32_t index_position_usteps = 0;
+  bool index_available = false;
+  bool stall = false;               // the stepper's stall detection (20A4 / 20A8)
+  bool stall_enters_fault = true;   // 20A7 = 0: FAULT; 1: stop only
+  uint8_t driver_errors = 0;        // kDriver* bits
+  // The power stage is on and the brake open (200A, 2002 sub 2 passed): motion may start.
+  bool ready = true;
+};
+
+// What the axis asks of the stepper this tick.
+struct AxisDemand {
+  int32_t position_usteps = 0;
+  int32_t velocity_pps = 0;
+  bool power_enabled = false;
+  bool brake_released_request = false;
+  bool switch_on_disabled = true;
+  bool clear_stall = false;  // the stall was handled: detect the next one
+};
+
+class AxisDrive {
+ public:
+  static constexpr double kDefaultClockHz = 12e6;
+  // csp/csv: a set-point written without a SYNC for this long is taken at once.
+  static constexpr uint32_t kSyncAbsentUs = 100'000;
+
+  ProfileObjects objects;
+
+  // Power-up and NMT reset node: SWITCH ON DISABLED, standing at `position`, objects kept.
+  void reset(int32_t position = 0);
+  void set_clock_hz(double clock_hz) { clock_hz_ = clock_hz; }
+  // Microsteps per motor revolution (2000 x 2001): index homing gives up after two revolutions.
+  void set_usteps_per_revolution(uint32_t usteps) { usteps_per_revolution_ = usteps; }
+
+  // 6040 written (SDO or RPDO).
+  void write_controlword(uint16_t controlword);
+  // 607A / 60FF written: csp/csv take the set-point at once when no SYNC drives them; in pp a
+  // 607A written in the same instant as the bit 4 edge (one RPDO) is the set-point taken.
+  void target_position_written();
+  void target_velocity_written();
+  // A SYNC (after the synchronous RPDOs were written): csp/csv take 607A + 60B0 / 60FF + 60B1.
+  void on_sync();
+  // A fault from outside the axis (NMT stopped while operation enabled, ...).
+  void external_fault() { pds_.fault(); }
+  // The position counter takes `position` without motion (homing, 200B sub 3 position
+  // initialisation); the encoder position is re-based to it.
+  void assign_position(int32_t position);
+
+  // One motion tick.
+  void step(const AxisInputs& inputs, uint32_t dt_us);
+
+  const AxisDemand& demand() const { return demand_; }
+  // A position assignment (homing) for the stepper since the last call.
+  bool take_position_assignment(int32_t& position);
+  bool take_emergency(AxisEmergency& out);
+
+  uint16_t statusword() const;
+  int8_t mode_display() const { return objects.mode; }  // 6061 follows 6060 at once
+  int32_t position_demand() const { return ramp_.position(); }  // 6062
+  int32_t position_actual() const;                               // 6063 / 6064
+  int32_t velocity_actual_value() const;                         // 606C in 208C units
+  double velocity_pps() const { return ramp_.velocity(); }
+  PdsState state() const { return pds_.state(); }
+  const PowerDriveSystem& pds() const { return pds_; }
+  const Homing& homing() const { return homing_; }
+  const motion::EightPointRamp& ramp() const { return ramp_; }
+  bool target_reached() const { return target_reached_; }
+  bool following_error() const { return following_error_; }
+  bool limit_active() const { return limit_active_; }
+  UnitScale units() const { return UnitScale::of(objects.velocity_dimension, clock_hz_); }
+  // The profile of the present mode in internal units (pp: 6081..6085 with 2010..2018).
+  motion::EightPointConfig profile_config() const;
+  // Software limits corrected by the home offset (607D, manual 6.1.11); false when unlimited.
+  bool min_limit(int64_t& limit) const;
+  bool max_limit(int64_t& limit) const;
+
+ private:
+  PdsOptions options() const;
+  void emergency(uint16_t code, uint8_t sub = 0);
+  void on_mode_change(int8_t from, int8_t to);
+  void accept_set_point(uint16_t controlword);
+  // 607A + the set-point's base, clamped to the software limits.
+  int32_t set_point_target();
+  void start_homing();
+  double slow_down_pps2() const;
+  void check_faults(const AxisInputs& inputs);
+  void run_pds_motion(const AxisInputs& inputs, double dt_s);
+  void run_mode(const AxisInputs& inputs, double dt_s);
+  void run_profile_position(const AxisInputs& inputs, double dt_s);
+  void run_profile_velocity(const AxisInputs& inputs, double dt_s);
+  void run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s);
+  void run_cyclic_position(double dt_s);
+  void run_cyclic_velocity(const AxisInputs& inputs, double dt_s);
+  void latch_cyclic_set_point();
+  // Limit switches and software limits: which directions are blocked now (EMCY FF01 on entry).
+  void update_limits(const AxisInputs& inputs);
+  // pv / csv: brakes on 6085 so that the axis stops exactly on a software limit it runs towards;
+  // true when it drove the ramp this tick.
+  bool brake_onto_software_limit(double target_pps, double velocity_ramp_pps2, double dt_s);
+  void stop_ramp(double deceleration_pps2);
+  void update_target_reached(const AxisInputs& inputs, uint32_t dt_us);
+  double interpolation_period_s() const;
+
+  double clock_hz_ = kDefaultClockHz;
+  uint32_t usteps_per_revolution_ = 51200;
+  PowerDriveSystem pds_;
+  motion::EightPointRamp ramp_;
+  Homing homing_;
+  AxisDemand demand_{};
+  int8_t active_mode_ = 0;
+  uint16_t controlword_ = 0;
+  // The config of the last ramp step (stops keep the profile's VSTOP).
+  motion::EightPointConfig ramp_config_{};
+
+  // Profile position.
+  int32_t target_ = 0;            // internal absolute target
+  bool moving_to_target_ = false; // a set-point is being executed
+  bool set_point_ack_ = false;    // statusword bit 12
+  bool pending_ = false;          // a buffered set-point (bit 5 = 0 while moving)
+  int32_t pending_target_ = 0;
+  bool set_point_refused_ = false;  // the last set-point was refused (warning bit 7)
+  // The last accepted set-point: taken in this tick (an RPDO's 607A after its 6040 replaces it),
+  // buffered or started, and what a relative 607A was added to.
+  bool set_point_taken_in_tick_ = false;
+  bool set_point_buffered_ = false;
+  int64_t set_point_base_ = 0;
+  uint32_t in_window_us_ = 0;
+  bool target_reached_ = true;
+  bool halted_ = false;
+  bool stopping_on_limit_ = false;
+
+  // csp / csv.
+  uint32_t us_since_sync_ = kSyncAbsentUs;
+  bool cyclic_latched_ = false;
+  int32_t cyclic_from_ = 0;
+  int32_t cyclic_to_ = 0;
+  double cyclic_velocity_from_ = 0;
+  double cyclic_velocity_to_ = 0;
+  double cyclic_elapsed_s_ = 0;
+
+  // Monitoring.
+  bool following_error_ = false;
+  bool limit_active_ = false;
+  bool limit_positive_ = false;
+  bool limit_negative_ = false;
+  bool limit_reported_[4] = {};  // software +/-, switch +/-: EMCY once per excursion
+  bool stall_latched_ = false;
+  bool stall_stop_ = false;  // stopped by a stall with 20A7 = 1 until a new command
+  bool clear_stall_request_ = false;  // demand.clear_stall in the next tick
+  uint8_t previous_driver_errors_ = 0;
+  int32_t actual_position_ = 0;
+  // The encoder keeps counting from its own zero: an assigned position (homing, 200B sub 3)
+  // re-bases it with this offset, so that 6064 and the following error stay in the demand's frame.
+  int32_t last_encoder_usteps_ = 0;
+  int32_t encoder_offset_ = 0;
+  bool negative_direction_ = false;
+
+  bool position_assigned_ = false;
+  int32_t assigned_position_ = 0;
+
+  std::array<AxisEmergency, 8> emcy_{};
+  size_t emcy_head_ = 0;
+  size_t emcy_count_ = 0;
+};
+
+}  // namespace motwin::cia402

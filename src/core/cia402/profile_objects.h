@@ -1,0 +1,98 @@
+// The CiA-402 objects of one axis (TMCM-3216 manual chapters 5-10; axis n at index + n x 0x800)
+// and the EightPoint ramp objects of the manufacturer area (2010..2018, 208C; + n x 0x200), as
+// the values a master wrote, in the objects' own units. The drive converts them to internal units
+// (microsteps, microsteps/s, microsteps/s²) where it uses them, so that 208C applies to every
+// velocity and acceleration object at once.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+namespace motwin::cia402 {
+
+// 6060 / 6061 values.
+enum class Mode : int8_t {
+  kNone = 0,
+  kProfilePosition = 1,
+  kProfileVelocity = 3,
+  kHoming = 6,
+  kCyclicSyncPosition = 8,
+  kCyclicSyncVelocity = 9,
+};
+constexpr bool supported_mode(int64_t value) {
+  return value == 0 || value == 1 || value == 3 || value == 6 || value == 8 || value == 9;
+}
+// 6502: bit 0 pp, 2 pv, 5 hm, 7 csp, 8 csv.
+inline constexpr uint32_t kSupportedDriveModes = (1u << 0) | (1u << 2) | (1u << 5) | (1u << 7) | (1u << 8);
+
+// 208C values.
+inline constexpr uint8_t kVelocityDimensionInternal = 0;
+inline constexpr uint8_t kVelocityDimensionPps = 181;
+// 208E values.
+inline constexpr uint8_t kAccelerationDimensionInternal = 0;
+inline constexpr uint8_t kAccelerationDimensionPps2 = 179;
+
+struct ProfileObjects {
+  // Option codes 605A..605E.
+  int16_t quick_stop_option = 2;
+  int16_t shutdown_option = 0;
+  int16_t disable_operation_option = 1;
+  int16_t halt_option = 1;
+  int16_t fault_reaction_option = 2;
+  int8_t mode = 0;                                  // 6060
+  int16_t sensor_selection = -1;                    // 606A: 0 encoder, -1 none
+  uint32_t following_error_window = 0;              // 6065, µsteps; 0 = off
+  uint32_t position_window = 0xFFFF'FFFF;           // 6067, µsteps; FFFFFFFF = off
+  uint16_t position_window_time_ms = 0;             // 6068
+  int32_t target_position = 0;                      // 607A
+  int32_t home_offset = 0;                          // 607C
+  int32_t software_limit_min = std::numeric_limits<int32_t>::min();  // 607D sub 1
+  int32_t software_limit_max = std::numeric_limits<int32_t>::max();  // 607D sub 2
+  // Velocities in 208C units, accelerations in 208E units. The manual's defaults of 6081, 6083
+  // and 6084 are 0, which would make its own examples (6.2, 7.2) stand still: see
+  // docs/tmcm-3216-drive.md "Decisions".
+  uint32_t profile_velocity = 51200;                // 6081
+  uint32_t end_velocity = 0;                        // 6082
+  uint32_t profile_acceleration = 51200;            // 6083
+  uint32_t profile_deceleration = 51200;            // 6084
+  uint32_t quick_stop_deceleration = 51200;         // 6085
+  uint16_t positioning_option = 0;                  // 60F2 bits 0, 1
+  int32_t target_velocity = 0;                      // 60FF
+  int8_t homing_method = 0;                         // 6098
+  uint32_t homing_speed_fast = 0;                   // 6099 sub 1
+  uint32_t homing_speed_slow = 0;                   // 6099 sub 2
+  uint32_t homing_acceleration = 0;                 // 609A; 0 = use 6083
+  int32_t position_offset = 0;                      // 60B0
+  int32_t velocity_offset = 0;                      // 60B1
+  uint8_t interpolation_period = 1;                 // 60C2 sub 1
+  int8_t interpolation_index = -3;                  // 60C2 sub 2: period = sub1 x 10^sub2 s
+  uint32_t encoder_increments = 1;                  // 608F sub 1 (per motor revolution)
+  // Manufacturer ramp objects (2010..2018, manual 4.2.10-4.2.17).
+  uint32_t start_velocity = 0;                      // 2010 VSTART
+  uint32_t a1 = 0;                                  // 2011
+  uint32_t v1 = 0;                                  // 2012
+  uint32_t d1 = 0;                                  // 2013
+  uint16_t ramp_wait_time = 0;                      // 2015, 32 µs units
+  uint32_t a2 = 0;                                  // 2016
+  uint32_t v2 = 0;                                  // 2017
+  uint32_t d2 = 0;                                  // 2018
+  uint8_t velocity_dimension = kVelocityDimensionPps;  // 208C
+};
+
+// Object units -> internal units. `clock_hz` is the driver chip's clock (TMC: v = v_reg x fCLK /
+// 2^24, a = a_reg x fCLK² / 2^41, motion-models.md).
+struct UnitScale {
+  double pps_per_velocity_unit = 1.0;
+  double pps2_per_acceleration_unit = 1.0;
+
+  static UnitScale of(uint8_t velocity_dimension, double clock_hz) {
+    if (velocity_dimension != kVelocityDimensionInternal) return UnitScale{};
+    return UnitScale{clock_hz / 16777216.0, clock_hz * clock_hz / 2199023255552.0};
+  }
+  double velocity_pps(double value) const { return value * pps_per_velocity_unit; }
+  double acceleration_pps2(double value) const { return value * pps2_per_acceleration_unit; }
+  // Internal velocity -> object units (606C), rounded towards zero.
+  int32_t velocity_value(double pps) const { return static_cast<int32_t>(pps / pps_per_velocity_unit); }
+};
+
+}  // namespace motwin::cia402

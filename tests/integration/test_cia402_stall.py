@@ -1,0 +1,87 @@
+#!/usr/bin/python3
+"""Stop on stall over the socketcand server with the physical NEMA17 model (--motor nema17): an
+obstacle blocks axis 0 at a scenario time (AXIS0_BLOCKED), StallGuard2's load value 2101 falls to
+0, the stop on stall (20A4 above 10000 pps) acts, EMCY 3230 names motor 0, and the axis goes to
+FAULT (20A7 = 0) or just stops and stays in operation enabled (20A7 = 1).
+"""
+
+import os
+import struct
+import sys
+import time
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from canopen_harness import NMT_START, CanServer, TestFailure, check, check_equal  # noqa: E402
+from motwin_harness import TempDir, run_tests  # noqa: E402
+
+NODE = 6
+BLOCK_AT_S = 6.0  # simulated seconds after start (3 s of wall time at --speed 2)
+
+
+def stall_run(tmp, option):
+    scenario = os.path.join(tmp, "scenario.txt")
+    with open(scenario, "w") as f:
+        f.write(f"{BLOCK_AT_S} AXIS0_BLOCKED 1\n")
+    server = CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE, speed="2",
+                       extra_args=["--motor", "nema17", "--scenario", scenario])
+    with server, server.bus() as bus:
+        bus.nmt(NMT_START, NODE)
+        bus.download(NODE, 0x2005, 0, 3, 4)         # no limit switches
+        bus.download(NODE, 0x20A4, 0, 10000, 4)     # stop on stall above 10000 pps
+        bus.download(NODE, 0x20A7, 0, option, 1)
+        bus.download(NODE, 0x6060, 0, 3, 1)
+        for cw in (6, 7, 15):
+            bus.download(NODE, 0x6040, 0, cw, 2)
+        bus.download(NODE, 0x60FF, 0, 40000, 4)
+        deadline = time.monotonic() + 2.5           # at speed (0.8 s simulated) well before the obstacle
+        while bus.upload_u(NODE, 0x606C, 0) != 40000:
+            check(time.monotonic() < deadline, "606C did not reach 40000 before the obstacle")
+            time.sleep(0.05)
+        time.sleep(0.2)
+        free_load = bus.upload_u(NODE, 0x2101, 0)
+        check(free_load > 200, f"2101 high while running freely: {free_load}")
+        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 6.0, "EMCY 3230")
+        data = bytes(emcy.data)
+        check_equal(struct.unpack_from("<H", data, 0)[0], 0x3230, "EMCY code: StallGuard2 error")
+        check_equal(data[4], 0, "additional byte 2: motor 0")
+        check_equal(bus.upload_u(NODE, 0x2101, 0), 0, "2101 at the stall")
+        time.sleep(0.6)
+        status = bus.upload_u(NODE, 0x6041, 0)
+        check_equal(bus.upload_u(NODE, 0x606C, 0), 0, "606C stopped")
+        server.stop()
+        return status
+
+
+def test_stall_enters_fault_with_option_0(motwin):
+    with TempDir() as tmp:
+        status = stall_run(tmp, 0)
+        check_equal(status & 0x4F, 0x08, f"FAULT after the stall (6041 = {status:#06x})")
+
+
+def test_stall_only_stops_with_option_1(motwin):
+    with TempDir() as tmp:
+        status = stall_run(tmp, 1)
+        check_equal(status & 0x6F, 0x27, f"still OPERATION ENABLED (6041 = {status:#06x})")
+
+
+def main():
+    global MOTWIN
+    import motwin_harness
+    args = motwin_harness.parse_arguments()
+    MOTWIN = os.path.abspath(args.motwin)
+    try:
+        import can  # noqa: F401
+    except ImportError:
+        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
+    run_tests([
+        test_stall_enters_fault_with_option_0,
+        test_stall_only_stops_with_option_1,
+    ])
+
+
+MOTWIN = None
+
+if __name__ == "__main__":
+    main()
