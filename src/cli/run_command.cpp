@@ -161,7 +161,10 @@ int run_run(const RunOptions& options) {
     throw RunError{fmt::format("--sample {}: expected a duration such as 1ms, 50us or 0.1s", options.sample)};
   }
   if (options.address && !options.label.empty()) throw RunError{"give at most one of --address and --label"};
-  const std::vector<uint8_t> params = parse_numbers(options.params.empty() ? std::vector<std::string>{"52,42"} : options.params, "--param");
+  // Default columns: actual position and velocity (TMCM-1636 AP 52/42, TMCM-142 AP 1/3).
+  const std::string default_params = options.module == "tmcm-142" ? "1,3" : "52,42";
+  const std::vector<uint8_t> params =
+      parse_numbers(options.params.empty() ? std::vector<std::string>{default_params} : options.params, "--param");
   const std::vector<uint8_t> variables = parse_numbers(options.variables, "--var");
 
   int exit_status = kExitSuccess;
@@ -323,7 +326,7 @@ void add_run_command(CLI::App& app, int& exit_status) {
   command->add_option("--sample", options->sample, "Sample period in simulated time (a multiple of the control tick)")
       ->type_name("DURATION")
       ->capture_default_str();
-  command->add_option("--param", options->params, "Axis parameters to trace, as 52,42 (repeatable; default 52,42)")
+  command->add_option("--param", options->params, "Axis parameters to trace, as 52,42 (repeatable; default 52,42, on tmcm-142 1,3)")
       ->type_name("N[,N...]");
   command->add_option("--var", options->variables, "User variables (GGP bank 2) to trace, as 0,1 (repeatable)")
       ->type_name("N[,N...]");

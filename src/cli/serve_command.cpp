@@ -139,7 +139,9 @@ std::optional<uint32_t> parse_bit_rate(const std::string& text) {
 }
 
 // One `can-stats` line for the interval since `before` (`interval_us` of simulated time).
-std::string format_can_stats(const host::CanBus& bus, const host::CanBusStats& before, uint64_t interval_us) {
+// Nodes that are or were off speed (or lost frames) follow, one " node NAME ..." part each.
+std::string format_can_stats(host::CanBus& bus, const host::CanBusStats& before, uint64_t interval_us,
+                             const std::vector<std::pair<std::string, host::CanBusNode*>>& nodes) {
   const host::CanBusStats& now = bus.stats();
   const uint64_t frames = now.frames - before.frames;
   const double load = interval_us == 0 ? 0.0
@@ -154,7 +156,12 @@ std::string format_can_stats(const host::CanBus& bus, const host::CanBusStats& b
                 static_cast<unsigned long long>(now.frames), static_cast<unsigned long long>(frames),
                 static_cast<unsigned long long>(now.bits - before.bits), load, mean_delay_ms,
                 static_cast<double>(now.max_queue_delay_ns) / 1e6, bus.bit_rate());
-  return line;
+  std::string text = line;
+  for (const auto& [name, node] : nodes) {
+    const host::CanNodeBusStats* stats = bus.node_stats(*node);
+    if (stats != nullptr && stats->any_trouble()) text += host::format_node_bus_stats(name, *stats);
+  }
+  return text;
 }
 
 int run_serve(const ServeArguments& arguments) {
@@ -272,15 +279,20 @@ int run_serve(const ServeArguments& arguments) {
   can_bus.set_bit_rate(*bit_rate);
   struct BusMembership {
     std::vector<host::CanBusNode*> nodes;
+    std::vector<std::pair<std::string, host::CanBusNode*>> named;  // for --can-stats
     ~BusMembership() {
       for (host::CanBusNode* node : nodes) node->disconnect();
     }
   } bus_membership;
   if (!can_specs.empty()) {
     if (group != nullptr) {
-      for (host::ModuleGroup::Member& member : group->members()) bus_membership.nodes.push_back(member.module->can_node());
+      for (host::ModuleGroup::Member& member : group->members()) {
+        bus_membership.nodes.push_back(member.module->can_node());
+        bus_membership.named.emplace_back(member.name, member.module->can_node());
+      }
     } else {
       bus_membership.nodes.push_back(module.can_node());
+      bus_membership.named.emplace_back(std::string(module.name()), module.can_node());
     }
     for (host::CanBusNode* node : bus_membership.nodes) node->connect(can_bus);
   }
@@ -370,8 +382,10 @@ int run_serve(const ServeArguments& arguments) {
     const uint64_t period_us = static_cast<uint64_t>(arguments.can_stats_s * 1e6);
     auto previous = std::make_shared<std::pair<host::CanBusStats, uint64_t>>(can_bus.stats(), module.sim_time_us());
     std::shared_ptr<std::function<void()>> report_stats = std::make_shared<std::function<void()>>();
-    *report_stats = [&runtime, &can_bus, &module, previous, period_us, weak = std::weak_ptr(report_stats)] {
-      print_line(format_can_stats(can_bus, previous->first, module.sim_time_us() - previous->second));
+    *report_stats = [&runtime, &can_bus, &module, &bus_membership, previous, period_us,
+                     weak = std::weak_ptr(report_stats)] {
+      print_line(format_can_stats(can_bus, previous->first, module.sim_time_us() - previous->second,
+                                  bus_membership.named));
       *previous = {can_bus.stats(), module.sim_time_us()};
       if (const auto again = weak.lock()) runtime.loop().add_timer_after(period_us, *again);
     };
@@ -416,11 +430,13 @@ void add_serve_command(CLI::App& app, int& exit_status) {
   serve->add_option("--can-bitrate", arguments->can_bitrate,
                     "Bit rate of the virtual bus (1M, 500k, 125000 ...): each frame occupies it for its bit count "
                     "with stuff bits and is stamped when its last bit is out; a TMCL module whose GP 69 differs is "
-                    "cut off. 0: frames take no time")
+                    "cut off, as is a TMCM-3216 whose active bit rate (2704 at reset, LSS) differs (counted per "
+                    "node in --can-stats). 0: frames take no time")
       ->type_name("RATE")
       ->capture_default_str();
   serve->add_option("--can-stats", arguments->can_stats_s,
-                    "Print a \"can-stats\" line (frames, bus load %, queueing delay) every SECONDS of wall time")
+                    "Print a \"can-stats\" line (frames, bus load %, queueing delay; nodes at another bit rate with "
+                    "their error counters) every SECONDS of wall time")
       ->type_name("SECONDS")
       ->check(CLI::PositiveNumber);
   serve->add_option("--tmcl-tcp", arguments->tcp_endpoints,
@@ -473,7 +489,8 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "Motor behind the power stage: ideal (the axis follows its ramp exactly; fast, the default), "
                     "a preset (default-24v, large-48v, dc-24v: physical models driven by the firmware's "
                     "regulators; a new EEPROM image gets the preset's start-up settings) or a motor description "
-                    "file (.json). See docs/tmcm-1636-servo.md")
+                    "file (.json). See docs/tmcm-1636-servo.md. The tmcm-142 takes ideal, nema17, nema23 or a stepper "
+                    "description file (docs/tmcm-142.md)")
       ->type_name(motor_names + "|FILE")
       ->capture_default_str();
   serve->add_option("--scenario", arguments->scenario_path,

@@ -1,5 +1,6 @@
 #include "host/module_registry.h"
 
+#include "host/tmcm142_virtual_module.h"
 #include "host/tmcm1636_virtual_module.h"
 #include "host/tmcm3216_virtual_module.h"
 #include "sim/tmcm1636_sim_board.h"
@@ -10,7 +11,9 @@ namespace {
 constexpr ModuleDescriptor kModules[] = {
     {"tmcm-1636", "TMCM-1636 1-axis BLDC/DC servo module, TMCL firmware 1636V109", &sim::Tmcm1636SimBoard::signal_table,
      &Tmcm1636VirtualModule::make},
-    {"tmcm-3216", "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-301 communication area)",
+    {"tmcm-142", "TMCM-142 1-axis stepper module (TMC457: S-ramps, encoder, easyPID), TMCL firmware 142V1.06",
+     &Tmcm142VirtualModule::signal_table, &Tmcm142VirtualModule::make},
+    {"tmcm-3216", "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-402 drive: pp, pv, hm, csp, csv)",
      &Tmcm3216VirtualModule::signal_table, &Tmcm3216VirtualModule::make},
 };
 

@@ -47,6 +47,25 @@ std::string check_signal_value(const SignalInfo& signal, double value) {
   return expected;
 }
 
+void OutputChangeLog::record(std::string_view signal, int32_t level) {
+  if (changes_.size() >= kMaxPending) {
+    changes_.erase(changes_.begin());
+    ++dropped_;
+  }
+  changes_.push_back(OutputChange{signal, level, sim_time_us_});
+}
+
+void OutputChangeLog::take(std::vector<OutputChange>& out) {
+  out.insert(out.end(), changes_.begin(), changes_.end());
+  changes_.clear();
+}
+
+std::vector<SignalInfo> concat_signals(std::span<const SignalInfo> first, std::span<const SignalInfo> second) {
+  std::vector<SignalInfo> all(first.begin(), first.end());
+  all.insert(all.end(), second.begin(), second.end());
+  return all;
+}
+
 std::string signal_names(std::span<const SignalInfo> signals) {
   std::string names;
   for (const SignalInfo& signal : signals) {

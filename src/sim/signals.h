@@ -28,6 +28,28 @@ struct OutputChange {
   uint64_t sim_time_us;
 };
 
+// The output changes a board recorded since the host last took them. Older changes are dropped
+// (and counted) beyond kMaxPending, so that a program toggling an output every tick cannot grow
+// memory unbounded.
+class OutputChangeLog {
+ public:
+  static constexpr size_t kMaxPending = 4096;
+
+  OutputChangeLog() { changes_.reserve(64); }
+
+  // Simulated time stamped on the changes recorded from now on; the virtual module sets it per tick.
+  void set_sim_time_us(uint64_t sim_time_us) { sim_time_us_ = sim_time_us; }
+  void record(std::string_view signal, int32_t level);
+  // Appends the recorded changes, oldest first, and forgets them.
+  void take(std::vector<OutputChange>& out);
+  size_t dropped() const { return dropped_; }
+
+ private:
+  uint64_t sim_time_us_ = 0;
+  std::vector<OutputChange> changes_;
+  size_t dropped_ = 0;
+};
+
 class SignalBoard {
  public:
   virtual ~SignalBoard() = default;
@@ -41,6 +63,20 @@ class SignalBoard {
   virtual void take_output_changes(std::vector<OutputChange>& out) = 0;
 };
 
+// A SignalBoard that records its output changes in an OutputChangeLog.
+class LoggingSignalBoard : public SignalBoard {
+ public:
+  static constexpr size_t kMaxPendingOutputChanges = OutputChangeLog::kMaxPending;
+
+  // Simulated time used to stamp output changes; the virtual module sets it per tick.
+  void set_sim_time_us(uint64_t sim_time_us) { output_changes_.set_sim_time_us(sim_time_us); }
+  size_t dropped_output_changes() const { return output_changes_.dropped(); }
+  void take_output_changes(std::vector<OutputChange>& out) override { output_changes_.take(out); }
+
+ protected:
+  OutputChangeLog output_changes_;
+};
+
 // Signal names are matched without regard to case ("gpi0" is GPI0).
 bool same_signal_name(std::string_view a, std::string_view b);
 
@@ -50,6 +86,9 @@ const SignalInfo* find_signal(std::span<const SignalInfo> signals, std::string_v
 // Empty when `value` is acceptable for `signal`, otherwise what was expected, for example
 // "GPI0 takes 0 or 1" or "VSUPPLY takes 0 to 100 (supply voltage in volts)".
 std::string check_signal_value(const SignalInfo& signal, double value);
+
+// `first` followed by `second`: a board's table made of its I/O's signals and the motor side's.
+std::vector<SignalInfo> concat_signals(std::span<const SignalInfo> first, std::span<const SignalInfo> second);
 
 // "GPI0, GPI1, ..., REF_H": for "unknown signal" messages.
 std::string signal_names(std::span<const SignalInfo> signals);

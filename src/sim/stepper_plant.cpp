@@ -8,6 +8,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kElectricalCircle = 4294967296.0;  // 2^32 per electrical revolution
+constexpr double kTwoTo32 = 4294967296.0;
+constexpr double kTurnLimit = 2305843009213693952.0;  // 2^61: differences of two stay in int64
 
 double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
@@ -71,6 +73,44 @@ StepperMotorDescription StepperMotorDescription::nema23() {
   motor.full_steps_per_revolution = 200;
   motor.viscous_friction_nm_s = 1e-4;
   return motor;
+}
+
+namespace {
+
+// Electrical stiffness and damping of the rotor as the stability check sees them.
+struct RotorSpring {
+  double stiffness_nm_per_rad;
+  double damping_nm_s;
+};
+
+RotorSpring rotor_spring(const StepperMotorDescription& motor, double sub_step_s) {
+  const double pole_pairs = motor.full_steps_per_revolution / 4.0;
+  const double k = motor.torque_constant_nm_per_a;
+  // Within one sub-step the back-EMF drives the current only (1 - exp(-h R / L)) of its way.
+  const double emf_share = -std::expm1(-sub_step_s * motor.resistance_ohm / motor.inductance_h);
+  return {(k * StepperPlant::kStabilityPeakCurrentA + 4.0 * motor.detent_torque_nm) * pole_pairs,
+          motor.viscous_friction_nm_s + k * k * emf_share / motor.resistance_ohm};
+}
+
+}  // namespace
+
+double StepperPlant::step_number(const StepperMotorDescription& motor, double sub_step_s) {
+  const RotorSpring spring = rotor_spring(motor, sub_step_s);
+  const double j = motor.rotor_inertia_kg_m2;
+  return sub_step_s * (std::sqrt(spring.stiffness_nm_per_rad / j) + spring.damping_nm_s / j);
+}
+
+double StepperPlant::min_stable_inertia_kg_m2(const StepperMotorDescription& motor, double sub_step_s) {
+  // h (sqrt(k) x + b x^2) = n with x = 1 / sqrt(J): the positive root.
+  const RotorSpring spring = rotor_spring(motor, sub_step_s);
+  const double h = sub_step_s;
+  const double n = kStableStepNumber;
+  const double root_k = std::sqrt(spring.stiffness_nm_per_rad);
+  const double x = spring.damping_nm_s > 0.0
+                       ? (-h * root_k + std::sqrt(h * h * spring.stiffness_nm_per_rad + 4.0 * h * spring.damping_nm_s * n)) /
+                             (2.0 * h * spring.damping_nm_s)
+                       : n / (h * root_k);
+  return 1.0 / (x * x);
 }
 
 StepperPlant::StepperPlant(const StepperMotorDescription& motor, int sub_steps)
@@ -178,14 +218,33 @@ void IdealStepper::set_position_revolutions(double position) {
 // --- StepperSensors -------------------------------------------------------------------------
 
 int32_t StepperSensors::encoder_count_at(double rotor_position_revolutions) const {
-  auto whole = static_cast<int64_t>(std::floor(rotor_position_revolutions * config_.encoder.counts_per_revolution));
+  const double counts = std::floor(rotor_position_revolutions * config_.encoder.counts_per_revolution);
+  if (!std::isfinite(counts)) return 0;
+  // The counter wraps at 32 bits: the remainder (exact for doubles) fits int64 for any position.
+  auto whole = static_cast<int64_t>(std::fmod(counts, kTwoTo32));
   if (config_.encoder.reversed) whole = -whole;
   return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(whole)));
 }
 
 void StepperSensors::sense(double rotor_position_revolutions, board::StepperFeedback& out) {
+  const bool finite = std::isfinite(rotor_position_revolutions);
+  auto level = [rotor_position_revolutions, finite](const StepperSensorConfig::Switch& sw) -> uint8_t {
+    const bool pressed = finite && sw.present && rotor_position_revolutions >= sw.from_revolutions &&
+                         rotor_position_revolutions <= sw.to_revolutions;
+    return pressed == sw.active_high ? 1 : 0;
+  };
+  out.switches = static_cast<uint8_t>(level(config_.right) | (level(config_.left) << 1) | (level(config_.home) << 2));
+  if (!finite) {
+    out.encoder_count = 0;
+    out.encoder_index_events = index_events_;
+    out.encoder_index_count = index_count_;
+    return;
+  }
   const double index = config_.encoder.index_revolutions;
-  const auto turn = static_cast<int64_t>(std::floor(rotor_position_revolutions - index));
+  // Turns beyond +-2^61 (only a runaway plant gets there) saturate instead of overflowing.
+  const double turns = std::floor(rotor_position_revolutions - index);
+  const int64_t turn = turns >= kTurnLimit ? static_cast<int64_t>(kTurnLimit)
+                                         : (turns <= -kTurnLimit ? -static_cast<int64_t>(kTurnLimit) : static_cast<int64_t>(turns));
   if (!started_) {
     started_ = true;
     last_index_turn_ = turn;
@@ -201,12 +260,6 @@ void StepperSensors::sense(double rotor_position_revolutions, board::StepperFeed
   out.encoder_count = config_.encoder.counts_per_revolution != 0 ? encoder_count_at(rotor_position_revolutions) : 0;
   out.encoder_index_events = index_events_;
   out.encoder_index_count = index_count_;
-  auto level = [rotor_position_revolutions](const StepperSensorConfig::Switch& sw) -> uint8_t {
-    const bool pressed =
-        sw.present && rotor_position_revolutions >= sw.from_revolutions && rotor_position_revolutions <= sw.to_revolutions;
-    return pressed == sw.active_high ? 1 : 0;
-  };
-  out.switches = static_cast<uint8_t>(level(config_.right) | (level(config_.left) << 1) | (level(config_.home) << 2));
 }
 
 }  // namespace motwin::sim

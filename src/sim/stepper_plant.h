@@ -38,6 +38,18 @@ struct StepperMotorDescription {
 class StepperPlant {
  public:
   static constexpr int kDefaultSubSteps = 4;
+  // The control tick of the boards that use the plant (TMCM-142 and TMCM-3216: 50 µs).
+  static constexpr double kBoardTickS = 50e-6;
+  // The largest peak coil current a module drives (TMCM-142: 7 A); the stability check assumes it.
+  static constexpr double kStabilityPeakCurrentA = 7.0;
+  // The rotor integration is explicit (semi-implicit Euler, stable below 2): a motor is accepted
+  // while h (sqrt(k / J) + b / J) stays below this per sub-step h, with k the stiffest electrical
+  // spring (Kt x kStabilityPeakCurrentA + 4 x detent, per mechanical rad) and b the damping
+  // (viscous friction and the back-EMF current one sub-step builds up).
+  static constexpr double kStableStepNumber = 0.5;
+  static double step_number(const StepperMotorDescription& motor, double sub_step_s);
+  // The smallest rotor inertia for which `motor` has step_number() <= kStableStepNumber.
+  static double min_stable_inertia_kg_m2(const StepperMotorDescription& motor, double sub_step_s);
 
   explicit StepperPlant(const StepperMotorDescription& motor, int sub_steps = kDefaultSubSteps);
 
@@ -138,7 +150,9 @@ class StepperSensors {
   // Reads the sensors at the rotor position: encoder count (floor of position x counts per
   // revolution, signed by the direction, wrapping at 32 bits), N pulses crossed since the last
   // call (each latches the count at the exact index angle) and the switch levels. The first call
-  // only establishes where the rotor is (no index crossing is counted from position 0).
+  // only establishes where the rotor is (no index crossing is counted from position 0). A
+  // position that is not finite (a diverged plant) counts 0, crosses no index and presses no
+  // switch.
   void sense(double rotor_position_revolutions, board::StepperFeedback& out);
 
   const StepperSensorConfig& config() const { return config_; }

@@ -23,11 +23,7 @@ enum MotorSignal : size_t { kLoadTorque, kLoadInertia, kBlocked, kRefRightAt, kR
 }  // namespace
 
 std::span<const SignalInfo> Tmcm1636SimBoard::signal_table() {
-  static const std::vector<SignalInfo> table = [] {
-    std::vector<SignalInfo> all(Tmcm1636SimIo::signal_table().begin(), Tmcm1636SimIo::signal_table().end());
-    all.insert(all.end(), std::begin(kMotorSignals), std::end(kMotorSignals));
-    return all;
-  }();
+  static const std::vector<SignalInfo> table = concat_signals(Tmcm1636SimIo::signal_table(), kMotorSignals);
   return table;
 }
 

@@ -39,7 +39,6 @@ std::span<const SignalInfo> Tmcm1636SimIo::signal_table() { return kSignals; }
 Tmcm1636SimIo::Tmcm1636SimIo() {
   set_supply_millivolt(kDefaultSupplyMillivolt);
   set_temperature_celsius(kDefaultTemperatureCelsius);
-  output_changes_.reserve(64);
 }
 
 bool Tmcm1636SimIo::digital_input(uint8_t port) const { return port < kDigitalInputCount && digital_inputs_[port]; }
@@ -57,11 +56,7 @@ uint16_t Tmcm1636SimIo::analog_input(uint8_t channel) const {
 void Tmcm1636SimIo::set_digital_output(uint8_t port, bool on) {
   if (port >= kDigitalOutputCount || digital_outputs_[port] == on) return;
   digital_outputs_[port] = on;
-  if (output_changes_.size() >= kMaxPendingOutputChanges) {
-    output_changes_.erase(output_changes_.begin());
-    ++dropped_output_changes_;
-  }
-  output_changes_.push_back(OutputChange{kOutputNames[port], on ? 1 : 0, sim_time_us_});
+  output_changes_.record(kOutputNames[port], on ? 1 : 0);
 }
 
 bool Tmcm1636SimIo::digital_output(uint8_t port) const { return port < kDigitalOutputCount && digital_outputs_[port]; }
@@ -131,11 +126,6 @@ std::optional<double> Tmcm1636SimIo::read_signal(std::string_view name) const {
   if (index == kSupply) return supply_millivolt_ / 1000.0;
   if (index == kTemperature) return temperature_celsius_;
   return reference_switch_levels_[index - kRefRight] ? 1.0 : 0.0;
-}
-
-void Tmcm1636SimIo::take_output_changes(std::vector<OutputChange>& out) {
-  out.insert(out.end(), output_changes_.begin(), output_changes_.end());
-  output_changes_.clear();
 }
 
 }  // namespace motwin::sim

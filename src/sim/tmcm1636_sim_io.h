@@ -15,13 +15,10 @@
 
 namespace motwin::sim {
 
-class Tmcm1636SimIo final : public board::Tmcm1636Io, public SignalBoard {
+class Tmcm1636SimIo final : public board::Tmcm1636Io, public LoggingSignalBoard {
  public:
   static constexpr int32_t kDefaultSupplyMillivolt = 24000;
   static constexpr double kDefaultTemperatureCelsius = 25.0;
-  // Output changes kept between two take_output_changes() calls; older ones are dropped (and
-  // counted) so that a program toggling an output every tick cannot grow memory unbounded.
-  static constexpr size_t kMaxPendingOutputChanges = 4096;
 
   // GPI0..3, AI0, AI1, VSUPPLY, TEMP, REF_R, REF_L, REF_H.
   static std::span<const SignalInfo> signal_table();
@@ -49,15 +46,11 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public SignalBoard {
   void set_measured_supply_raw(uint16_t raw) { supply_raw_ = raw; }
   void set_measured_temperature_celsius(double celsius);
 
-  // Simulated time used to stamp output changes; the host module wrapper sets it per tick.
-  void set_sim_time_us(uint64_t sim_time_us) { sim_time_us_ = sim_time_us; }
-  size_t dropped_output_changes() const { return dropped_output_changes_; }
 
   // SignalBoard.
   std::span<const SignalInfo> input_signals() const override { return signal_table(); }
   void set_input(std::string_view name, double value) override;
   std::optional<double> read_signal(std::string_view name) const override;
-  void take_output_changes(std::vector<OutputChange>& out) override;
 
  private:
   std::array<bool, kDigitalInputCount> digital_inputs_{};
@@ -68,9 +61,6 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public SignalBoard {
   uint16_t temperature_raw_ = 0;
   std::array<bool, kDigitalOutputCount> digital_outputs_{};
   std::array<bool, 3> reference_switch_levels_{};
-  uint64_t sim_time_us_ = 0;
-  std::vector<OutputChange> output_changes_;
-  size_t dropped_output_changes_ = 0;
 };
 
 }  // namespace motwin::sim

@@ -2,7 +2,7 @@
 """The EEPROM image of `motwin serve` (`<state-dir>/tmcm-1636.eeprom`).
 
 - Stored values (STAP, STGP, auto-stored SGP) survive a restart after SIGTERM or SIGINT;
-  unstored ones do not.
+  unstored ones do not. GP 85 = 1 makes the stored user variables start at 0 after a restart.
 - A damaged image (bytes flipped, truncated, extended, empty, another module's image, random
   bytes) is reported by exactly one stderr line containing "damaged"; the module starts from
   factory defaults, works, and its next store writes a valid image again.
@@ -116,6 +116,35 @@ def test_restart_keeps_stored_values(motwin):
                 c.sgp(77, BANK_GLOBAL, DEFAULT_AUTO_START)
             server.stop()
         check_equal(read_eeprom_image(image_path(state)).global_parameter(77), DEFAULT_AUTO_START, "GP 77 slot")
+
+
+
+def test_gp_85_decides_whether_user_variables_come_back(motwin):
+    """GP 85 = 1 (stored at once, like every SGP from 64 on): after a restart the stored user
+    variables start at 0, and RSGP still fetches the stored copy; GP 85 = 0: they come back."""
+    with TempDir() as tmp:
+        state = os.path.join(tmp, "state")
+        with Server(motwin, state) as server:
+            with server.tcp() as c:
+                c.sgp(3, BANK_USER, 1234)
+                c.stgp(3, BANK_USER)
+                c.sgp(85, BANK_GLOBAL, 1)
+            server.stop()
+        check_equal((read_eeprom_image(image_path(state)).global_parameter(85),
+                     read_eeprom_image(image_path(state)).user_variable(3)), (1, 1234), "GP 85 and variable 3 in the file")
+        with Server(motwin, state) as server:
+            with server.tcp() as c:
+                check_equal(c.ggp(85, BANK_GLOBAL), 1, "GP 85 after the restart")
+                check_equal(c.ggp(3, BANK_USER), 0, "GP 85 = 1: user variable 3 starts at 0")
+                c.rsgp(3, BANK_USER)
+                check_equal(c.ggp(3, BANK_USER), 1234, "RSGP fetches the stored copy")
+                c.sgp(85, BANK_GLOBAL, 0)
+                c.sgp(3, BANK_USER, 5)  # RAM only
+            server.stop()
+        with Server(motwin, state) as server:
+            with server.tcp() as c:
+                check_equal(c.ggp(3, BANK_USER), 1234, "GP 85 = 0: user variable 3 restored")
+            server.stop()
 
 
 # --- Damaged images -------------------------------------------------------------------------
@@ -427,5 +456,5 @@ def test_sigterm_under_load(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_restart_keeps_stored_values, test_damaged_images, test_state_dir_in_use, test_sigterm_under_load,
-               test_kill9_loop])
+    run_tests([test_restart_keeps_stored_values, test_gp_85_decides_whether_user_variables_come_back,
+               test_damaged_images, test_state_dir_in_use, test_sigterm_under_load, test_kill9_loop])

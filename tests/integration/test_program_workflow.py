@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """The TMCL program workflow from the command line: `motwin download` (assemble, download,
-verify with 134) against `motwin serve` over TCP, `motwin start|stop|step|status`, a read-back
-mismatch against a fake module, and `motwin run` writing a CSV trace whose values are checked.
+verify with 134) against `motwin serve` over TCP and over its pseudo-terminal (`--serial`),
+`motwin start|stop|step|status`, a downloaded program that survives a restart of `motwin serve`
+on the same state directory and autostarts (GP 77), a read-back mismatch against a fake module,
+and `motwin run` writing a CSV trace whose values are checked.
 """
 
 import csv
@@ -17,7 +19,8 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from motwin_harness import (  # noqa: E402
-    GAP, Server, TempDir, check, check_equal, checksum, expect_reply, run_tests,
+    BANK_GLOBAL, BANK_USER, DEFAULT_AUTO_START, GAP, Server, TempDir, check, check_equal, checksum, expect_reply,
+    run_tests,
 )
 
 PROGRAMS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "programs")
@@ -122,6 +125,82 @@ def test_stop_step_and_registers(motwin):
             check(int(fields["X register"]) in (accumulator, accumulator + 1), f"CALCX LOAD copies A to X: {fields!r}")
             motwin_cli(motwin, "start", "--tcp", endpoint, "--continue")
             check_equal(status_fields(motwin, server.tcp_port)["application status"], "run (1)", "continued")
+            server.stop()
+
+
+# Sets user variable 100 (not stored, so only the program can make it 42) and counts in 101.
+# The assembler appends a STOP: 5 instructions.
+COUNTER_PROGRAM = "SGP 100, 2, 42\nLoop: CALC ADD, 1\n      AGP 101, 2\n      JA Loop\n"
+
+
+def write_counter_program(tmp):
+    source = os.path.join(tmp, "counter.tmc")
+    with open(source, "w") as f:
+        f.write(COUNTER_PROGRAM)
+    return source
+
+
+def check_counter_program_runs(client, what):
+    client.wait_for(f"{what}: user variable 100 = 42", lambda: client.ggp(100, BANK_USER) == 42, timeout=10)
+    check_equal(client.ggp(128, BANK_GLOBAL), 1, f"{what}: GP 128 application status run")
+    first = client.ggp(101, BANK_USER)
+    client.wait_for(f"{what}: the loop counts", lambda: client.ggp(101, BANK_USER) != first, timeout=5)
+
+
+def test_downloaded_program_survives_a_restart_and_autostarts(motwin):
+    """Download (not started), restart `motwin serve` on the same state directory: the program is
+    in program memory (134) and GP 77 = 1 started it at power-up. With GP 77 = 0 it stays stopped."""
+    with TempDir() as tmp:
+        source = write_counter_program(tmp)
+        state = os.path.join(tmp, "state")
+        with Server(motwin, state) as server:
+            out = motwin_cli(motwin, "download", source, "--tcp", f"127.0.0.1:{server.tcp_port}").stdout
+            check("5 instructions downloaded to addresses 0..4" in out and "verified" in out, f"download said {out!r}")
+            with server.tcp() as client:
+                check_equal(client.ggp(77, BANK_GLOBAL), DEFAULT_AUTO_START, "GP 77 factory default: autostart")
+                check_equal(client.ggp(128, BANK_GLOBAL), 0, "a download does not start the program")
+                check_equal(client.ggp(100, BANK_USER), 0, "nothing ran before the restart")
+            server.stop()
+        with Server(motwin, state) as server:
+            with server.tcp() as client:
+                check_counter_program_runs(client, "after the restart")
+                # The program itself came back from the image: SGP 100, 2, 42 at address 0, JA 1 at 3.
+                reply = client.request(READ_MEMORY, 0, 0, 0)
+                check_equal((reply.status, reply.command, reply.value), (100, 9, 42), "134 type 0 at address 0")
+                reply = client.request(READ_MEMORY, 1, 0, 0)
+                check_equal((reply.status, reply.command, reply.value), (100, 9, (100 << 8) | 2), "134 type 1 at 0")
+                reply = client.request(READ_MEMORY, 0, 0, 3)
+                check_equal((reply.status, reply.command, reply.value), (100, 22, 1), "134 type 0 at address 3")
+            check_equal(status_fields(motwin, server.tcp_port)["application status"], "run (1)", "motwin status")
+            with server.tcp() as client:
+                client.sgp(77, BANK_GLOBAL, 0)  # automatically stored
+            server.stop()
+        with Server(motwin, state) as server:
+            with server.tcp() as client:
+                time.sleep(0.3)
+                check_equal(client.ggp(128, BANK_GLOBAL), 0, "GP 77 = 0: no autostart")
+                check_equal(client.ggp(100, BANK_USER), 0, "the program did not run")
+                check_equal(client.request(READ_MEMORY, 0, 0, 0).value, 42, "but it is still stored")
+            server.stop()
+
+
+def test_download_and_start_over_the_serial_pty(motwin):
+    """`motwin download --serial` and `motwin start --serial` on the server's pseudo-terminal,
+    then a pyserial client on the same link sees the program run."""
+    with TempDir() as tmp:
+        source = write_counter_program(tmp)
+        link = os.path.join(tmp, "tmcm1636")
+        with Server(motwin, os.path.join(tmp, "state"), tcp=False, pty_link=link) as server:
+            out = motwin_cli(motwin, "download", source, "--serial", link).stdout
+            check("5 instructions downloaded to addresses 0..4" in out and "verified" in out, f"download said {out!r}")
+            with server.serial() as client:
+                check_equal(client.ggp(128, BANK_GLOBAL), 0, "downloaded, not started")
+                reply = client.request(READ_MEMORY, 0, 0, 2)
+                check_equal((reply.status, reply.command, reply.value), (100, 35, 0), "134 at 2: AGP 101, 2")
+            out = motwin_cli(motwin, "start", "--serial", link).stdout
+            check("program started" in out, f"start said {out!r}")
+            with server.serial() as client:
+                check_counter_program_runs(client, "started over the pty")
             server.stop()
 
 
@@ -244,6 +323,8 @@ def test_run_variables_and_a_faulting_program(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_download_start_status, test_stop_step_and_registers, test_download_reports_a_read_back_mismatch,
+    run_tests([test_download_start_status, test_stop_step_and_registers,
+               test_downloaded_program_survives_a_restart_and_autostarts, test_download_and_start_over_the_serial_pty,
+               test_download_reports_a_read_back_mismatch,
                test_download_of_a_bad_program_sends_nothing, test_run_writes_a_trace,
                test_run_until_stopped_with_a_label_and_stdout, test_run_variables_and_a_faulting_program])

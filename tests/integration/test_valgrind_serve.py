@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The server's start/stop path under valgrind's memcheck: `motwin serve` for a TMCM-1636 (TCP
 and pty) and a TMCM-3216 (socketcand), each started, asked one request (GAP 43 = 4000; an SDO
-upload of 1000 = FFFC0192), then stopped with SIGTERM. Any invalid access, use of uninitialised
+upload of 1000 = FFFF0192), then stopped with SIGTERM. Any invalid access, use of uninitialised
 memory or definite/indirect leak makes valgrind exit with status 99 instead of motwin's 0.
 
 Skipped (reported, exit 0) when valgrind is not installed or the binary is built with

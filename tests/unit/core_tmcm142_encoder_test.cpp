@@ -88,6 +88,44 @@ TEST(Tmcm142Encoder, deviation_stops_the_motor_and_flags_edv) {
   EXPECT_NEAR(rig.gap(41), start + 10240, 60);
 }
 
+// AP 207 reports the deviation stop as an event: set when the deviation starts, cleared by the
+// read, and not set again while the same deviation lasts (AP 129 bit 3 shows the condition).
+// Only a new excursion, after AP 1 and AP 41 agreed again, sets it again.
+TEST(Tmcm142Encoder, ap_207_is_set_once_per_deviation_and_stays_cleared_after_a_read) {
+  Tmcm142Rig rig(StepperMotor::kPhysical);
+  use_fine_encoder(rig);
+  use_pps(rig, 100000, 1000000);
+  ASSERT_EQ(rig.sap(212, 2000), kOk);
+  rig.plant.set_blocked(true);
+  ASSERT_EQ(rig.command(4, 0, 0, 102400).status, kOk);
+  rig.run_ms(500);
+  EXPECT_EQ(rig.gap(207), 2);
+  for (int i = 0; i < 5; ++i) {
+    rig.run_ms(100);  // ticks between the reads, the deviation lasting
+    EXPECT_EQ(rig.gap(129) & 8, 8);
+    EXPECT_EQ(rig.gap(207), 0) << "read " << i << " after the clearing read";
+  }
+  // A new move while the deviation lasts is stopped at once; no new event.
+  const int32_t stopped_at = rig.gap(1);
+  ASSERT_EQ(rig.command(4, 0, 0, 204800).status, kOk);
+  rig.run_ms(100);
+  EXPECT_EQ(rig.gap(1), stopped_at);
+  EXPECT_EQ(rig.gap(207), 0);
+  // Realigned, then blocked again: a second event.
+  ASSERT_EQ(rig.command(3, 0, 0, 0).status, kOk);
+  ASSERT_EQ(rig.sap(1, rig.gap(41)), kOk);
+  rig.run_ms(10);
+  EXPECT_EQ(rig.gap(129) & 8, 0);
+  EXPECT_EQ(rig.gap(207), 0);
+  ASSERT_EQ(rig.command(36, 3, 0, 0).status, kOk);  // CLE EDV
+  ASSERT_EQ(rig.command(4, 1, 0, 10240).status, kOk);  // MVP REL
+  rig.run_ms(500);
+  EXPECT_EQ(rig.gap(129) & 8, 8);
+  EXPECT_EQ(rig.gap(207), 2) << "the second excursion";
+  EXPECT_EQ(rig.gap(207), 0);
+  EXPECT_NE(rig.module.runtime().error_flags & tmcl::kErrorDeviation, 0) << "EDV raised again";
+}
+
 void download(Tmcm142Rig& rig, std::initializer_list<tmcl::Instruction> program) {
   ASSERT_EQ(rig.command(132, 0, 0, 0).status, kOk);
   for (const auto& in : program) ASSERT_EQ(rig.command(in.command, in.type, in.motor_bank, in.value).status, 101);

@@ -33,13 +33,13 @@ MakeModuleResult make_quiet(ModuleOptions options = {}) {
 }
 
 TEST(ModuleRegistry, knows_the_tmcm_1636_and_refuses_unknown_names) {
-  EXPECT_EQ(module_names(), "tmcm-1636, tmcm-3216");
+  EXPECT_EQ(module_names(), "tmcm-1636, tmcm-142, tmcm-3216");
   ASSERT_NE(find_module("tmcm-1636"), nullptr);
   // 11 I/O signals (GPI0..REF_H) and 8 of the motor (LOAD_TORQUE..HALL_FAULT).
   EXPECT_EQ(find_module("tmcm-1636")->input_signals().size(), 19u);
   const MakeModuleResult unknown = make_module("tmcm-9999", {});
   EXPECT_FALSE(unknown.module);
-  EXPECT_EQ(unknown.error, "unknown module \"tmcm-9999\" (available: tmcm-1636, tmcm-3216)");
+  EXPECT_EQ(unknown.error, "unknown module \"tmcm-9999\" (available: tmcm-1636, tmcm-142, tmcm-3216)");
 }
 
 TEST(VirtualModule, a_tmcm_1636_in_memory_describes_itself) {

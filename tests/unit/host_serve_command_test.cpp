@@ -141,7 +141,7 @@ TEST(ServeCommand, bad_arguments_exit_with_status_2_and_one_error_line) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--tmcl-tcp", "127.0.0.1:70000"},
        "motwin: error: --tmcl-tcp: expected HOST:PORT with a port from 0 to 65535, got \"127.0.0.1:70000\"\n"},
-      {{"--module", "tmcm-9"}, "motwin: error: unknown module \"tmcm-9\" (available: tmcm-1636, tmcm-3216)\n"},
+      {{"--module", "tmcm-9"}, "motwin: error: unknown module \"tmcm-9\" (available: tmcm-1636, tmcm-142, tmcm-3216)\n"},
       {{"--speed", "slow"},
        "motwin: error: --speed takes realtime, fast or a factor from 0.001 to 10000, got \"slow\"\n"},
       {{"--set", "GPI0=3"}, "motwin: error: --set GPI0=3: GPI0 takes 0 or 1 (digital input level), got 3\n"},

@@ -354,6 +354,62 @@ TEST(StepperSensors, index_pulse_once_per_revolution_latches_the_count) {
   EXPECT_EQ(feedback.encoder_index_count, 21000);
 }
 
+// hfuzz finding: a diverged plant's rotor position (1e19 revolutions, inf, NaN) was converted to
+// int64 (undefined behaviour). Counts wrap at 32 bits for any finite position; a position that
+// is not a number counts 0, crosses no index pulse and presses no switch.
+TEST(StepperSensors, huge_and_non_finite_positions_are_defined) {
+  StepperSensorConfig config;
+  config.encoder.counts_per_revolution = 4000;
+  config.home = {true, 1.0, 1e300, false};  // active low: pressed reads 0
+  StepperSensors sensors(config);
+  // 2^62 revolutions x 4000 is a multiple of 2^32; 2^31 + 0.25 revolutions leaves 1000.
+  EXPECT_EQ(sensors.encoder_count_at(std::ldexp(1.0, 62)), 0);
+  EXPECT_EQ(sensors.encoder_count_at(-std::ldexp(1.0, 62)), 0);
+  EXPECT_EQ(sensors.encoder_count_at(std::ldexp(1.0, 31) + 0.25), 1000);
+  EXPECT_EQ(sensors.encoder_count_at(1e300), sensors.encoder_count_at(1e300));
+  EXPECT_EQ(sensors.encoder_count_at(HUGE_VAL), 0);
+  EXPECT_EQ(sensors.encoder_count_at(std::nan("")), 0);
+  board::StepperFeedback feedback;
+  sensors.sense(0.5, feedback);
+  EXPECT_EQ(feedback.encoder_count, 2000);
+  EXPECT_EQ(feedback.switches, 0b100);
+  sensors.sense(std::nan(""), feedback);
+  EXPECT_EQ(feedback.encoder_count, 0);
+  EXPECT_EQ(feedback.encoder_index_events, 0u);
+  EXPECT_EQ(feedback.switches, 0b100) << "released";
+  sensors.sense(1e25, feedback);  // a runaway: the turn count saturates instead of overflowing
+  EXPECT_EQ(feedback.encoder_count, sensors.encoder_count_at(1e25));
+  EXPECT_EQ(feedback.switches, 0b000);
+  sensors.sense(-1e25, feedback);
+  EXPECT_EQ(feedback.encoder_count, sensors.encoder_count_at(-1e25));
+  sensors.sense(0.5, feedback);
+  EXPECT_EQ(feedback.encoder_count, 2000);
+}
+
+// The stability bound the stepper JSON parser applies: the presets lie far inside it, and a
+// rotor just above the smallest stable inertia holds its position at the stiffest current.
+TEST(StepperPlant, rotor_integration_is_stable_above_the_minimum_inertia) {
+  const double h = kDt / StepperPlant::kDefaultSubSteps;
+  EXPECT_LT(StepperPlant::step_number(StepperMotorDescription::nema17(), h), 0.06);
+  EXPECT_LT(StepperPlant::step_number(StepperMotorDescription::nema23(), h), 0.03);
+  StepperMotorDescription light = StepperMotorDescription::nema23();
+  light.rotor_inertia_kg_m2 = StepperPlant::min_stable_inertia_kg_m2(light, h);
+  EXPECT_NEAR(StepperPlant::step_number(light, h), StepperPlant::kStableStepNumber, 1e-9);
+  light.rotor_inertia_kg_m2 *= 1.01;
+  StepperPlant plant(light);
+  board::StepperDrive drive;
+  drive.enabled = true;
+  drive.coil_a_ma = 7000;  // holding at electrical angle 0 with the assumed peak current
+  plant.set_position_revolutions(0.001);  // 0.2 full steps off the equilibrium
+  double largest = 0;
+  for (int i = 0; i < 2000; ++i) {
+    plant.advance(drive, 48.0, kDt);
+    largest = std::max(largest, std::fabs(plant.position_revolutions()));
+  }
+  EXPECT_LE(largest, 0.0011) << "no growth beyond the start";
+  EXPECT_LT(std::fabs(plant.position_revolutions()), 0.0002) << "settles towards 0";
+}
+
 TEST(StepperSensors, switches_at_their_positions_with_polarity) {
   StepperSensorConfig config;
   config.right = {true, 5.0, 1e300, true};    // pressed from 5 revolutions on, reads 1

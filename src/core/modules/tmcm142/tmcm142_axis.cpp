@@ -205,14 +205,19 @@ void Tmcm142Axis::check_deviation() {
   const int64_t magnitude = difference < 0 ? -static_cast<int64_t>(difference) : difference;
   const bool exceeded = config.max_encoder_deviation > 0 && magnitude > config.max_encoder_deviation;
   if (exceeded) {
-    if (!state.deviation_exceeded) deviation_event_ = true;
+    // AP 207 and EDV report the event (the deviation starting), not the condition: AP 129 bit 3
+    // shows the condition. Setting AP 207 on every tick of a lasting deviation would undo the
+    // clear-on-read between two host reads.
+    if (!state.deviation_exceeded) {
+      deviation_event_ = true;
+      state.error_flags |= error_flag::kDeviationStop;
+    }
     if (!ramp_.standstill()) ramp_.stop_now();
     if (ramp_.mode() == motion::SRamp::Mode::kVelocity) {
       state.target_velocity_pps = 0.0;
       ramp_.set_velocity_target(0.0);
     }
     if (search_.running()) search_.stop();
-    state.error_flags |= error_flag::kDeviationStop;
   }
   state.deviation_exceeded = exceeded;
 }

@@ -1,0 +1,27 @@
+// The control loop of a virtual module on its simulated board, the same for every module: per
+// tick the board samples its sensors, the firmware ticks, the board moves the motors.
+#pragma once
+
+#include <cstdint>
+
+namespace motwin::host {
+
+// Runs `count` ticks from `tick_count` on and returns the new tick count. Output changes are
+// stamped (through `output_clock.set_sim_time_us`) with the start of the tick that made them;
+// afterwards the clock stands at the end of the last tick. `tick_s` is passed apart from
+// `tick_us` so that each module integrates with the very constant its firmware uses.
+template <typename SimBoard, typename Device, typename OutputClock>
+uint64_t run_board_ticks(uint64_t count, uint64_t tick_count, uint32_t tick_us, double tick_s, SimBoard& sim_board,
+                         Device& device, OutputClock& output_clock) {
+  for (uint64_t i = 0; i < count; ++i) {
+    output_clock.set_sim_time_us(tick_count * tick_us);
+    sim_board.before_tick();
+    device.tick();
+    sim_board.after_tick(tick_s);
+    ++tick_count;
+  }
+  output_clock.set_sim_time_us(tick_count * tick_us);
+  return tick_count;
+}
+
+}  // namespace motwin::host

@@ -1,0 +1,60 @@
+// Where a virtual module keeps its EEPROM image: a file in the state directory (`--state-dir`,
+// host/eeprom_file.h) or, without one, memory holding a fresh factory image. Each module's
+// make() opens one before it constructs the firmware on nvm().
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <utility>
+
+#include "board/non_volatile_memory.h"
+#include "board/ram_non_volatile_memory.h"
+#include "host/eeprom_file.h"
+#include "host/module_registry.h"
+
+namespace motwin::host {
+
+// What a module's image file is checked against: the module's name, layout version and size.
+template <typename Device>
+EepromImageIdentity eeprom_identity_of() {
+  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, Device::kNvmLayout.total_size};
+}
+
+template <size_t kImageSize>
+class ModuleEeprom {
+ public:
+  using MemoryImage = board::RamNonVolatileMemory<kImageSize>;
+
+  // Opens (or creates) the file when options.state_dir is set, otherwise formats a memory image.
+  // False, with `error` set, when the file cannot be used.
+  bool open(const ModuleOptions& options, const EepromImageIdentity& identity,
+            const FactoryImageFormatter& format_factory_image, std::string& error) {
+    if (options.state_dir) {
+      EepromFile::OpenResult opened = EepromFile::open(*options.state_dir, identity, format_factory_image, options.log);
+      if (!opened.file) {
+        error = opened.error;
+        return false;
+      }
+      file_ = std::move(opened.file);
+      nvm_ = file_.get();
+    } else {
+      memory_image_ = std::make_unique<MemoryImage>();
+      format_factory_image(memory_image_->mutable_data(), memory_image_->size());
+      nvm_ = memory_image_.get();
+    }
+    return true;
+  }
+
+  board::NonVolatileMemory& nvm() { return *nvm_; }
+  const EepromFile* file() const { return file_.get(); }
+  // The file's path, or "none" for a memory image (VirtualModule::nvm_location()).
+  std::string location() const { return file_ ? file_->path().string() : "none"; }
+
+ private:
+  std::unique_ptr<EepromFile> file_;
+  std::unique_ptr<MemoryImage> memory_image_;
+  board::NonVolatileMemory* nvm_ = nullptr;
+};
+
+}  // namespace motwin::host

@@ -1,0 +1,149 @@
+#include "sim/stepper_motor_selection.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace motwin::sim {
+namespace {
+
+using Json = nlohmann::json;
+
+// The description's real-valued fields as a declarative table: JSON key, field and the physical
+// range of a stepper motor (NEMA8 to NEMA42 with margin; docs/tmcm-142.md, Decisions). 0 is
+// allowed only where the lower bound is 0 (a motor without cogging or friction).
+struct NumberField {
+  const char* key;
+  double StepperMotorDescription::* field;
+  double min;
+  double max;
+};
+
+constexpr NumberField kNumberFields[] = {
+    {"resistance_ohm", &StepperMotorDescription::resistance_ohm, 0.01, 1000.0},
+    {"inductance_h", &StepperMotorDescription::inductance_h, 1e-6, 10.0},
+    {"torque_constant_nm_per_a", &StepperMotorDescription::torque_constant_nm_per_a, 1e-3, 20.0},
+    {"detent_torque_nm", &StepperMotorDescription::detent_torque_nm, 0.0, 10.0},
+    {"rotor_inertia_kg_m2", &StepperMotorDescription::rotor_inertia_kg_m2, 1e-8, 1.0},
+    {"friction_torque_nm", &StepperMotorDescription::friction_torque_nm, 0.0, 100.0},
+    {"rated_current_a", &StepperMotorDescription::rated_current_a, 0.01, 20.0},
+    {"viscous_friction_nm_s", &StepperMotorDescription::viscous_friction_nm_s, 0.0, 10.0},
+};
+
+std::string number_text(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+// The plant integrates the rotor explicitly: a stiff, light rotor would diverge. Names the key
+// that usually needs changing (the inertia) with the smallest value this motor allows.
+std::string stability_error(const StepperMotorDescription& motor) {
+  const double sub_step_s = StepperPlant::kBoardTickS / StepperPlant::kDefaultSubSteps;
+  if (StepperPlant::step_number(motor, sub_step_s) <= StepperPlant::kStableStepNumber) return {};
+  return "\"rotor_inertia_kg_m2\" must be at least " + number_text(StepperPlant::min_stable_inertia_kg_m2(motor, sub_step_s)) +
+         " for this torque constant, detent torque, viscous friction and step count (the simulation's " +
+         number_text(sub_step_s * 1e6) + " us steps would diverge; " + number_text(StepperPlant::kStabilityPeakCurrentA) +
+         " A peak assumed)";
+}
+
+std::string preset_list() {
+  std::string names = "ideal";
+  for (std::string_view name : stepper_motor_preset_names()) names += ", " + std::string(name);
+  return names;
+}
+
+}  // namespace
+
+std::vector<std::string_view> stepper_motor_preset_names() { return {"nema17", "nema23"}; }
+
+std::optional<StepperMotorDescription> stepper_motor_preset(std::string_view name) {
+  if (name == "nema17") return StepperMotorDescription::nema17();
+  if (name == "nema23") return StepperMotorDescription::nema23();
+  return std::nullopt;
+}
+
+StepperMotorChoice parse_stepper_motor_description(std::string_view json_text, std::string_view source_name) {
+  StepperMotorChoice result;
+  const std::string prefix = std::string(source_name) + ": ";
+  const Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
+  if (document.is_discarded() || !document.is_object()) {
+    result.error = prefix + "expected a JSON object";
+    return result;
+  }
+  std::string base = "nema23";
+  if (auto it = document.find("base"); it != document.end()) {
+    if (!it->is_string() || !stepper_motor_preset(it->get<std::string>())) {
+      result.error = prefix + "\"base\" must be a preset name (nema17, nema23)";
+      return result;
+    }
+    base = it->get<std::string>();
+  }
+  StepperMotorDescription motor = *stepper_motor_preset(base);
+  motor.name = std::string(source_name);
+  for (const auto& [key, value] : document.items()) {
+    if (key == "base") continue;
+    if (key == "name") {
+      if (!value.is_string()) {
+        result.error = prefix + "\"name\" must be a string";
+        return result;
+      }
+      motor.name = value.get<std::string>();
+      continue;
+    }
+    if (key == "full_steps_per_revolution") {
+      // Whole electrical periods (4 full steps) per revolution.
+      if (!value.is_number_integer() || value.get<int64_t>() < 4 || value.get<int64_t>() > 4000 ||
+          value.get<int64_t>() % 4 != 0) {
+        result.error = prefix + "\"full_steps_per_revolution\" must be a multiple of 4 from 4 to 4000";
+        return result;
+      }
+      motor.full_steps_per_revolution = static_cast<int>(value.get<int64_t>());
+      continue;
+    }
+    const NumberField* field = nullptr;
+    for (const NumberField& candidate : kNumberFields) {
+      if (key == candidate.key) field = &candidate;
+    }
+    if (field == nullptr) {
+      result.error = prefix + "unknown key \"" + key + "\"";
+      return result;
+    }
+    const double number = value.is_number() ? value.get<double>() : -1.0;
+    if (!std::isfinite(number) || number < field->min || number > field->max) {
+      result.error = prefix + "\"" + key + "\" must be a number from " + number_text(field->min) + " to " +
+                     number_text(field->max);
+      return result;
+    }
+    motor.*(field->field) = number;
+  }
+  if (std::string unstable = stability_error(motor); !unstable.empty()) {
+    result.error = prefix + unstable;
+    return result;
+  }
+  result.motor = motor;
+  return result;
+}
+
+StepperMotorChoice resolve_stepper_motor(std::string_view name_or_path) {
+  StepperMotorChoice result;
+  if (name_or_path.empty() || name_or_path == "ideal") return result;
+  if (auto preset = stepper_motor_preset(name_or_path)) {
+    result.motor = std::move(preset);
+    return result;
+  }
+  const std::string path(name_or_path);
+  std::ifstream file(path);
+  if (!file) {
+    result.error =
+        "unknown stepper motor \"" + path + "\" (expected " + preset_list() + " or a .json stepper description)";
+    return result;
+  }
+  std::ostringstream text;
+  text << file.rdbuf();
+  return parse_stepper_motor_description(text.str(), path);
+}
+
+}  // namespace motwin::sim
