@@ -5,7 +5,6 @@
 // running; each case is printed as a multiple of it, with the marginal cost per instruction.
 // Prints figures only; see docs/benchmarks.md.
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "core/tmcl/engine.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
@@ -96,28 +96,8 @@ void run_case(benchmark::State& state, const std::string& source) {
 }
 
 // The console table, then each case against the idle baseline.
-class RatioReporter final : public benchmark::ConsoleReporter {
+class RatioReporter final : public motwin::bench::SummaryReporter {
  public:
-  RatioReporter() : ConsoleReporter(::isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.error_occurred) continue;
-      const bool is_median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type != Run::RT_Iteration && !is_median) continue;
-      Figures& figures = figures_[run.run_name.function_name];
-      figures.wall_ms_per_sim_s = run.GetAdjustedRealTime() * milliseconds_per_unit(run);
-      const auto counter = [&](const char* name) {
-        const auto found = run.counters.find(name);
-        return found == run.counters.end() ? 0.0 : found->second.value;
-      };
-      figures.instructions_per_sim_s = counter("instr_per_sim_s");
-      figures.instructions_per_wall_s = counter("instr_per_wall_s");
-      figures.instructions_per_iteration = counter("instr_per_iteration");
-    }
-  }
-
   void Finalize() override {
     ConsoleReporter::Finalize();
     const auto baseline = figures_.find(kBaselineName);
@@ -138,6 +118,16 @@ class RatioReporter final : public benchmark::ConsoleReporter {
     }
   }
 
+ protected:
+  void collect(const Run& run) override {
+    Figures& figures = figures_[run.run_name.function_name];
+    figures.wall_ms_per_sim_s = motwin::bench::real_time_seconds(run) * 1e3;
+    const auto counter = [&](const char* name) { return motwin::bench::find_counter(run, name).value_or(0.0); };
+    figures.instructions_per_sim_s = counter("instr_per_sim_s");
+    figures.instructions_per_wall_s = counter("instr_per_wall_s");
+    figures.instructions_per_iteration = counter("instr_per_iteration");
+  }
+
  private:
   struct Figures {
     double wall_ms_per_sim_s = 0;
@@ -145,16 +135,6 @@ class RatioReporter final : public benchmark::ConsoleReporter {
     double instructions_per_wall_s = 0;
     double instructions_per_iteration = 0;
   };
-
-  static double milliseconds_per_unit(const Run& run) {
-    switch (run.time_unit) {
-      case benchmark::kNanosecond: return 1e-6;
-      case benchmark::kMicrosecond: return 1e-3;
-      case benchmark::kMillisecond: return 1.0;
-      case benchmark::kSecond: return 1e3;
-    }
-    return 1.0;
-  }
 
   std::map<std::string, Figures> figures_;
 };

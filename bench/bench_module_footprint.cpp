@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/modules/tmcm142/tmcm142.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "host/module_registry.h"
@@ -43,6 +44,7 @@ double cpu_seconds() {
 }
 
 std::string core_size(std::string_view name) {
+  if (name == modules::tmcm142::Tmcm142::kName) return std::to_string(sizeof(modules::tmcm142::Tmcm142));
   if (name == modules::tmcm1636::Tmcm1636::kName) return std::to_string(sizeof(modules::tmcm1636::Tmcm1636));
   if (name == modules::tmcm3216::Tmcm3216::kName) return std::to_string(sizeof(modules::tmcm3216::Tmcm3216));
   return "n/a";

@@ -4,13 +4,8 @@
 // the encoder and switch sensors. The baseline, measured in the same run, is the S-ramp alone.
 // Goal: well above 200x for the whole axis. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <map>
-#include <string>
-#include <vector>
-
+#include "bench_support.h"
 #include "board/stepper_drive.h"
 #include "core/motion/microstep_table.h"
 #include "core/motion/s_ramp.h"
@@ -41,10 +36,7 @@ motion::SRampConfig ramp_config() {
   return config;
 }
 
-void report(benchmark::State& state) {
-  state.counters["sim_s_per_s"] =
-      benchmark::Counter(kSimSecondsPerIteration * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-}
+void report(benchmark::State& state) { motwin::bench::report_real_time_factor(state, kSimSecondsPerIteration); }
 
 int32_t next_target(int32_t target) { return target == 0 ? static_cast<int32_t>(8 * kMicrostepsPerRev) : 0; }
 
@@ -125,39 +117,6 @@ void plant_axis(benchmark::State& state, sim::StepperMotorDescription motor_desc
   report(state);
 }
 
-class RealTimeFactorReporter final : public benchmark::ConsoleReporter {
- public:
-  RealTimeFactorReporter() : ConsoleReporter(::isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.error_occurred) continue;
-      const bool is_median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type != Run::RT_Iteration && !is_median) continue;
-      const auto counter = run.counters.find("sim_s_per_s");
-      if (counter != run.counters.end()) factor_[run.run_name.function_name] = counter->second.value;
-    }
-  }
-
-  void Finalize() override {
-    ConsoleReporter::Finalize();
-    const auto baseline = factor_.find(kBaselineName);
-    std::printf("\nReal-time factor (simulated seconds per CPU second, one core), same run:\n");
-    for (const auto& [name, factor] : factor_) {
-      std::printf("  %-28s %9.0fx", name.c_str(), factor);
-      if (baseline != factor_.end() && name != kBaselineName && factor > 0.0) {
-        std::printf("  (%5.1fx slower than the S-ramp alone)  goal >= %.0fx: %s", baseline->second / factor,
-                    kGoalRealTimeFactor, factor >= kGoalRealTimeFactor ? "met" : "NOT met");
-      }
-      std::printf("\n");
-    }
-  }
-
- private:
-  std::map<std::string, double> factor_;
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -169,7 +128,7 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("plant_axis/nema23", plant_axis, sim::StepperMotorDescription::nema23())
       ->Unit(benchmark::kMillisecond);
-  RealTimeFactorReporter reporter;
+  motwin::bench::RealTimeFactorReporter reporter({kBaselineName, "the S-ramp alone", kGoalRealTimeFactor, 28});
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

@@ -3,7 +3,6 @@
 // measured in the same run (the checksum of the frame alone) turns the absolute times into
 // ratios that compare across machines. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <map>
@@ -11,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_support.h"
 #include "../tests/unit/support/tmcm1636_rig.h"
 #include "core/tmcl/serial_link.h"
 #include "tools/tmcl_mnemonics.h"
@@ -75,23 +75,8 @@ void checksum_only(benchmark::State& state, Frame frame) {
 }
 
 // The console table, then each case's time as a multiple of the baseline.
-class RatioReporter final : public benchmark::ConsoleReporter {
+class RatioReporter final : public motwin::bench::SummaryReporter {
  public:
-  // Colours only on a terminal, as the library's own reporter chooses by default.
-  RatioReporter() : ConsoleReporter(::isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.error_occurred) continue;
-      // With --benchmark_repetitions the median aggregate is the figure to compare.
-      const bool is_median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type == Run::RT_Iteration || is_median) {
-        nanoseconds_per_frame_[run.run_name.function_name] = run.GetAdjustedRealTime() * nanoseconds_per_unit(run);
-      }
-    }
-  }
-
   void Finalize() override {
     ConsoleReporter::Finalize();
     const auto baseline = nanoseconds_per_frame_.find(kBaselineName);
@@ -104,17 +89,12 @@ class RatioReporter final : public benchmark::ConsoleReporter {
     }
   }
 
- private:
-  static double nanoseconds_per_unit(const Run& run) {
-    switch (run.time_unit) {
-      case benchmark::kNanosecond: return 1.0;
-      case benchmark::kMicrosecond: return 1e3;
-      case benchmark::kMillisecond: return 1e6;
-      case benchmark::kSecond: return 1e9;
-    }
-    return 1.0;
+ protected:
+  void collect(const Run& run) override {
+    nanoseconds_per_frame_[run.run_name.function_name] = motwin::bench::real_time_seconds(run) * 1e9;
   }
 
+ private:
   std::map<std::string, double> nanoseconds_per_frame_;
 };
 

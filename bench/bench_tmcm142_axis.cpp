@@ -4,13 +4,8 @@
 // baseline, measured in the same run, is the module on the ideal stepper. Goal: at least 200x
 // on the physical NEMA23 model with the easyPID closed. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <map>
-#include <string>
-#include <vector>
-
+#include "bench_support.h"
 #include "../tests/unit/support/tmcm142_rig.h"
 
 namespace {
@@ -23,10 +18,7 @@ constexpr double kGoalRealTimeFactor = 200.0;
 constexpr uint64_t kTicksPerIteration = 20'000;  // one simulated second
 constexpr double kSimSecondsPerIteration = kTicksPerIteration * motwin::modules::tmcm142::kControlTickS;
 
-void report(benchmark::State& state) {
-  state.counters["sim_s_per_s"] =
-      benchmark::Counter(kSimSecondsPerIteration * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-}
+void report(benchmark::State& state) { motwin::bench::report_real_time_factor(state, kSimSecondsPerIteration); }
 
 // MVP back and forth by one revolution with S-ramps (default bows), one simulated second each.
 void moves(benchmark::State& state, StepperMotor motor, bool closed_loop) {
@@ -46,39 +38,6 @@ void moves(benchmark::State& state, StepperMotor motor, bool closed_loop) {
   report(state);
 }
 
-class RealTimeFactorReporter final : public benchmark::ConsoleReporter {
- public:
-  RealTimeFactorReporter() : ConsoleReporter(::isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.error_occurred) continue;
-      const bool is_median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type != Run::RT_Iteration && !is_median) continue;
-      const auto counter = run.counters.find("sim_s_per_s");
-      if (counter != run.counters.end()) factor_[run.run_name.function_name] = counter->second.value;
-    }
-  }
-
-  void Finalize() override {
-    ConsoleReporter::Finalize();
-    const auto baseline = factor_.find(kBaselineName);
-    std::printf("\nReal-time factor (simulated seconds per CPU second, one core), same run:\n");
-    for (const auto& [name, factor] : factor_) {
-      std::printf("  %-40s %9.0fx", name.c_str(), factor);
-      if (baseline != factor_.end() && name != kBaselineName && factor > 0.0) {
-        std::printf("  (%5.1fx slower than the ideal stepper)  goal >= %.0fx: %s", baseline->second / factor,
-                    kGoalRealTimeFactor, factor >= kGoalRealTimeFactor ? "met" : "NOT met");
-      }
-      std::printf("\n");
-    }
-  }
-
- private:
-  std::map<std::string, double> factor_;
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -89,7 +48,7 @@ int main(int argc, char** argv) {
       ->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("tmcm142_nema23_easypid", moves, StepperMotor::kPhysical, true)
       ->Unit(benchmark::kMillisecond);
-  RealTimeFactorReporter reporter;
+  motwin::bench::RealTimeFactorReporter reporter({kBaselineName, "the ideal stepper", kGoalRealTimeFactor, 40});
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

@@ -4,14 +4,10 @@
 // measured in the same run, is the ideal motor (the axis follows its ramp, no regulators, no
 // plant). Goal: at least 200x for the full cascade. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <map>
 #include <memory>
-#include <string>
-#include <vector>
 
+#include "bench_support.h"
 #include "../tests/unit/support/tmcm1636_rig.h"
 #include "../tests/unit/support/tmcm1636_servo_rig.h"
 
@@ -25,10 +21,7 @@ constexpr double kGoalRealTimeFactor = 200.0;
 constexpr uint64_t kTicksPerIteration = 20'000;  // one simulated second
 constexpr double kSimSecondsPerIteration = kTicksPerIteration * motwin::modules::tmcm1636::kControlTickUs * 1e-6;
 
-void report(benchmark::State& state) {
-  state.counters["sim_s_per_s"] =
-      benchmark::Counter(kSimSecondsPerIteration * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
-}
+void report(benchmark::State& state) { motwin::bench::report_real_time_factor(state, kSimSecondsPerIteration); }
 
 // Baseline: the ideal motor in velocity mode.
 void ideal_motor(benchmark::State& state) {
@@ -68,39 +61,6 @@ void servo_position(benchmark::State& state, const char* motor) {
   report(state);
 }
 
-class RealTimeFactorReporter final : public benchmark::ConsoleReporter {
- public:
-  RealTimeFactorReporter() : ConsoleReporter(::isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      if (run.error_occurred) continue;
-      const bool is_median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.run_type != Run::RT_Iteration && !is_median) continue;
-      const auto counter = run.counters.find("sim_s_per_s");
-      if (counter != run.counters.end()) factor_[run.run_name.function_name] = counter->second.value;
-    }
-  }
-
-  void Finalize() override {
-    ConsoleReporter::Finalize();
-    const auto baseline = factor_.find(kBaselineName);
-    std::printf("\nReal-time factor (simulated seconds per CPU second, one core), same run:\n");
-    for (const auto& [name, factor] : factor_) {
-      std::printf("  %-40s %9.0fx", name.c_str(), factor);
-      if (baseline != factor_.end() && name != kBaselineName && factor > 0.0) {
-        std::printf("  (%5.1fx slower than the ideal motor)  goal >= %.0fx: %s", baseline->second / factor,
-                    kGoalRealTimeFactor, factor >= kGoalRealTimeFactor ? "met" : "NOT met");
-      }
-      std::printf("\n");
-    }
-  }
-
- private:
-  std::map<std::string, double> factor_;
-};
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -111,7 +71,7 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("servo_position/default-24v", servo_position, "default-24v")->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("servo_position/large-48v", servo_position, "large-48v")->Unit(benchmark::kMillisecond);
   benchmark::RegisterBenchmark("servo_velocity/dc-24v", servo_velocity, "dc-24v")->Unit(benchmark::kMillisecond);
-  RealTimeFactorReporter reporter;
+  motwin::bench::RealTimeFactorReporter reporter({kBaselineName, "the ideal motor", kGoalRealTimeFactor, 40});
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;

@@ -91,6 +91,20 @@ def sdo_seeds():
             write(target, f"random_{n}", bytes(rng.randrange(256) for _ in range(n)))
 
 
+def engine_seeds():
+    # The ramp, homing, TMCM-3216 drive and TMCM-142 engine targets read FuzzedDataProvider input
+    # too; their own generator, so that the seeds of the targets above stay as they are.
+    rng = random.Random(402)
+    for n in (64, 256, 1024, 4096):
+        for target in ("eight_point_ramp", "cia402_homing", "tmcm3216_drive", "tmcm142_engine"):
+            for k in range(2):
+                write(target, f"random_{n}_{k}", bytes(rng.randrange(256) for _ in range(n)))
+    # tmcm3216_drive's last byte is its bring-up: bits 0-2 the axes enabled, 3-5 the mode
+    # (pp, pv, hm, csp, csv, ...), 6 no NMT start, 7 limit switches off (2005 = 3).
+    for bring_up in (0x07, 0x0F, 0x17, 0x1F, 0x27, 0x81, 0x89, 0x91, 0x99, 0xA1, 0xC7):
+        write("tmcm3216_drive", f"bring_up_{bring_up:02x}", bytes(rng.randrange(256) for _ in range(512)) + bytes([bring_up]))
+
+
 def can_text_seeds():
     socketcand = [
         "< open vcan0 >< rawmode >",
@@ -133,6 +147,30 @@ def text_file_seeds():
     write("motor_description", "dc", '{"name": "dc", "type": "dc", "torque_constant_nm_per_a": 0.05}\n')
 
 
+def tmcm142_board_seeds():
+    # Byte 0: bit 0 physical motor (the JSON), bits 1-3 the motion (0 ROR, 1 ROL, 2/3 MVP +/-,
+    # 4 RFS, 5 RFS with another mode, else none), bits 4-7 its size; then motor JSON, NUL, scenario.
+    motors = [
+        "",
+        '{"base": "nema17"}',
+        '{"base": "nema23", "name": "bench", "resistance_ohm": 0.8, "inductance_h": 0.0021, '
+        '"torque_constant_nm_per_a": 0.35, "detent_torque_nm": 0, "rotor_inertia_kg_m2": 2.7e-5, '
+        '"friction_torque_nm": 0.01, "rated_current_a": 2.8, "viscous_friction_nm_s": 0, '
+        '"full_steps_per_revolution": 400}',
+    ]
+    scenarios = [
+        "# axis.scn (docs/tmcm-142.md)\n0    REF_L_AT  -0.25\n0    REF_R_AT   1.5\n0.05 BLOCKED    1\n",
+        "0 REF_H_FROM 0.01\n0 REF_H_TO 0.02\n0.02 LOAD_TORQUE 0.5\n0.03 LOAD_INERTIA 1e-4\n",
+        "0 ENCODER_CPR 4000\n0.01 ENCODER_INDEX_AT 0.5\n0.02 ENCODER_REVERSED 1\n0.04 ENCODER_FAULT 1\n"
+        "0.06 ENCODER_FAULT 0\n",
+        "0 VSUPPLY 12\n0.01 IN0 1\n0.02 AIN0 2048\n0.03 REF_R 1\n0.04 REF_R 0\n0.05 VSUPPLY 48\n",
+    ]
+    for i, (control, motor, scenario) in enumerate([
+            (0x00, 0, 0), (0x13, 2, 1), (0x25, 1, 2), (0x07, 2, 0), (0x09, 0, 0), (0x1B, 1, 0),
+            (0x31, 2, 3), (0x0E, 0, 2), (0x41, 2, 2)]):
+        write("tmcm142_board", f"seed_{i}", bytes([control]) + motors[motor].encode() + b"\0" + scenarios[scenario].encode())
+
+
 def eeprom_seeds(motwin):
     if not motwin:
         return
@@ -166,8 +204,10 @@ def main():
     tmcl_seeds()
     program_seeds()
     sdo_seeds()
+    engine_seeds()
     can_text_seeds()
     text_file_seeds()
+    tmcm142_board_seeds()
     eeprom_seeds(args.motwin and os.path.abspath(args.motwin))
     for target in sorted(os.listdir(CORPUS)):
         print(f"{target}: {len(os.listdir(os.path.join(CORPUS, target)))} seeds")

@@ -1,0 +1,184 @@
+// The TMCM-142's simulated board (src/sim/tmcm142_sim_board.*) with its files: a stepper motor
+// description (src/sim/stepper_motor_selection.*: any JSON text) and a scenario file against
+// the board's signal table (src/sim/scenario.*), run under the TMCM-142 firmware.
+//
+// Input: byte 0 picks the motion the firmware runs (rotate either way, a position move, a
+// reference search, none) and whether the motor JSON is used (else the ideal motor); then the
+// motor JSON up to the first NUL byte; then the scenario text.
+//
+// Invariants:
+// - a motor description that loads keeps the parser's promises: every real-valued field finite
+//   and positive (detent, friction and viscous friction may be 0), full steps a multiple of 4
+//   from 4 to 4000, a rotor the plant integrates stably (StepperPlant::step_number); text that
+//   does not load names the source in its error;
+// - a scenario that parses gives events sorted by time (file order among equal times), each on a
+//   signal of the TMCM-142 table in its canonical spelling with a value it accepts, a time
+//   within bounds and a line inside the text; errors name the source and line;
+// - 100 ms of firmware and board with the events applied as their times come (and all of them
+//   at the end): every reading finite (position, speed, coil currents, torque), the encoder
+//   count the firmware sees as the sensors compute it from the rotor position (unless the
+//   encoder is faulty or an input changed in that tick), every writable axis parameter inside
+//   its row's range.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "board/ram_non_volatile_memory.h"
+#include "core/modules/tmcm142/tmcm142.h"
+#include "core/tmcl/instruction.h"
+#include "fuzz_support.h"
+#include "sim/scenario.h"
+#include "sim/stepper_motor_selection.h"
+#include "sim/tmcm142_sim_board.h"
+#include "sim/tmcm142_sim_io.h"
+
+namespace {
+
+using namespace motwin;
+using Tmcm142 = modules::tmcm142::Tmcm142;
+using Tmcm142Nvm = board::RamNonVolatileMemory<Tmcm142::kNvmLayout.total_size>;
+
+void check_motor(const sim::StepperMotorChoice& choice) {
+  if (!choice.motor) {
+    FUZZ_CHECK(choice.error.rfind("fuzz-motor.json: ", 0) == 0, "error without its source: %s", choice.error.c_str());
+    return;
+  }
+  const sim::StepperMotorDescription& m = *choice.motor;
+  for (double value : {m.resistance_ohm, m.inductance_h, m.torque_constant_nm_per_a, m.rotor_inertia_kg_m2,
+                       m.rated_current_a}) {
+    FUZZ_CHECK(std::isfinite(value) && value > 0.0, "a loaded motor with %g where a positive number belongs", value);
+  }
+  for (double value : {m.detent_torque_nm, m.friction_torque_nm, m.viscous_friction_nm_s}) {
+    FUZZ_CHECK(std::isfinite(value) && value >= 0.0, "a loaded motor with %g where a number >= 0 belongs", value);
+  }
+  FUZZ_CHECK(m.full_steps_per_revolution >= 4 && m.full_steps_per_revolution <= 4000 &&
+                 m.full_steps_per_revolution % 4 == 0,
+             "full steps per revolution %d", m.full_steps_per_revolution);
+  // The parser refuses motors whose explicit rotor integration would diverge.
+  const double sub_step_s = modules::tmcm142::kControlTickS / sim::StepperPlant::kDefaultSubSteps;
+  FUZZ_CHECK(sim::StepperPlant::step_number(m, sub_step_s) <= sim::StepperPlant::kStableStepNumber,
+             "a loaded motor the plant cannot integrate stably: step number %g",
+             sim::StepperPlant::step_number(m, sub_step_s));
+}
+
+void check_events(const sim::ScenarioParseResult& result, std::string_view text) {
+  const auto signals = sim::Tmcm142SimBoard::signal_table();
+  size_t lines = 1;
+  for (char c : text) lines += c == '\n' ? 1 : 0;
+  for (size_t i = 0; i < result.events.size(); ++i) {
+    const sim::ScenarioEvent& event = result.events[i];
+    const sim::SignalInfo* signal = sim::find_signal(signals, event.signal);
+    FUZZ_CHECK(signal != nullptr && signal->name == event.signal, "event signal '%s'", event.signal.c_str());
+    FUZZ_CHECK(std::isfinite(event.value) && sim::check_signal_value(*signal, event.value).empty(), "%s = %g",
+               event.signal.c_str(), event.value);
+    FUZZ_CHECK(event.time_us <= static_cast<uint64_t>(sim::kMaxScenarioTimeS * 1e6), "time %llu us",
+               static_cast<unsigned long long>(event.time_us));
+    FUZZ_CHECK(event.line >= 1 && event.line <= lines, "line %zu of %zu", event.line, lines);
+    if (i > 0) {
+      const sim::ScenarioEvent& previous = result.events[i - 1];
+      FUZZ_CHECK(previous.time_us < event.time_us || (previous.time_us == event.time_us && previous.line < event.line),
+                 "events %zu and %zu out of order", i - 1, i);
+    }
+  }
+}
+
+void check_axis_parameters(Tmcm142& module, const char* when) {
+  for (const auto& row : Tmcm142::axis_parameters().rows()) {
+    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
+      continue;
+    }
+    int32_t value = 0;
+    if (module.get_axis_parameter(static_cast<uint8_t>(row.info.number), 0, value) != tmcl::Status::kOk) continue;
+    FUZZ_CHECK(params::in_range(row.info, value), "%s: AP %u (%.*s) holds %d, range %lld..%lld", when,
+               row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
+               static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < 1 || size > 32 * 1024) return 0;
+  const uint8_t control = data[0];
+  const std::string_view rest(reinterpret_cast<const char*>(data + 1), size - 1);
+  const size_t nul = rest.find('\0');
+  const std::string_view json = rest.substr(0, nul);
+  const std::string_view scenario = nul == std::string_view::npos ? std::string_view() : rest.substr(nul + 1);
+
+  const sim::StepperMotorChoice motor = sim::parse_stepper_motor_description(json, "fuzz-motor.json");
+  check_motor(motor);
+  sim::ScenarioParseResult events = sim::parse_scenario(scenario, "fuzz.scn", sim::Tmcm142SimBoard::signal_table());
+  if (!events.ok()) {
+    FUZZ_CHECK(events.error.rfind("fuzz.scn:", 0) == 0, "error without its source: %s", events.error.c_str());
+    events.events.clear();
+  }
+  check_events(events, scenario);
+  if (std::getenv("MOTWIN_FUZZ_TRACE") != nullptr) {  // for reading a saved input
+    std::fprintf(stderr, "motor: %s; scenario: %zu events %s\n", motor.motor ? motor.motor->name.c_str() : motor.error.c_str(),
+                 events.events.size(), events.error.c_str());
+  }
+  const size_t event_count = events.events.size();
+
+  // As Tmcm142VirtualModule::make and run_ticks wire them.
+  auto io = std::make_unique<sim::Tmcm142SimIo>();
+  const bool physical = (control & 1) != 0 && motor.motor.has_value();
+  auto board = physical ? std::make_unique<sim::Tmcm142SimBoard>(*io, *motor.motor)
+                        : std::make_unique<sim::Tmcm142SimBoard>(*io);
+  auto nvm = std::make_unique<Tmcm142Nvm>();
+  Tmcm142::format_factory_image(nvm->mutable_data(), nvm->size());
+  sim::ScenarioPlayer player(std::move(events.events), *board);
+  player.apply_due(0);  // time-0 events are the initial inputs
+  board->before_tick();
+  auto module = std::make_unique<Tmcm142>(*nvm, board->power_stage(), *io);
+  module->engine().power_up();
+
+  const int32_t amount = static_cast<int32_t>((control >> 4) + 1) * 5000;
+  const auto execute = [&](uint8_t command, uint8_t type, int32_t value) {
+    module->engine().execute(tmcl::Instruction{command, type, 0, value}, tmcl::Origin::kHost);
+  };
+  switch ((control >> 1) & 7) {
+    case 0: execute(tmcl::command::kRor, 0, amount * 20); break;
+    case 1: execute(tmcl::command::kRol, 0, amount * 20); break;
+    case 2: execute(tmcl::command::kMvp, 0, amount); break;
+    case 3: execute(tmcl::command::kMvp, 0, -amount); break;
+    case 4: execute(tmcl::command::kRfs, 0, 0); break;
+    case 5:
+      execute(tmcl::command::kSap, 193, (control >> 4) & 7);  // another reference search mode
+      execute(tmcl::command::kRfs, 0, 0);
+      break;
+    default: break;  // standing still, powered
+  }
+
+  constexpr uint32_t kTicks = 100 * modules::tmcm142::kTicksPerMillisecond;
+  for (uint32_t tick = 0; tick < kTicks; ++tick) {
+    const uint64_t now_us = uint64_t{tick} * modules::tmcm142::kControlTickUs;
+    io->set_sim_time_us(now_us);
+    const bool inputs_changed = player.apply_due(now_us) != 0;
+    board->before_tick();
+    if (!inputs_changed && board->read_signal("ENCODER_FAULT") == 0.0) {
+      // The count the firmware sees is the one the sensors compute from the rotor position.
+      const int32_t expected = board->sensors().encoder_count_at(board->rotor_revolutions());
+      FUZZ_CHECK(board->power_stage().feedback.encoder_count == expected, "encoder count %d, rotor says %d at tick %u",
+                 board->power_stage().feedback.encoder_count, expected, tick);
+    }
+    module->tick();
+    board->after_tick(modules::tmcm142::kControlTickS);
+    for (const char* name : {"POSITION_REV", "SPEED_RPM", "COIL_A_A", "COIL_B_A", "TORQUE_NM"}) {
+      const auto value = board->read_signal(name);
+      FUZZ_CHECK(!value || std::isfinite(*value), "%s is %g after tick %u", name, *value, tick);
+    }
+    if (tick % 500 == 499) check_axis_parameters(*module, "while running");
+  }
+  const size_t applied_on_time = player.applied_count();
+  const size_t applied_late = player.apply_due(UINT64_MAX);
+  FUZZ_CHECK(applied_on_time + applied_late == event_count && player.finished(), "not every event was applied");
+  board->before_tick();
+  module->tick();
+  check_axis_parameters(*module, "after the scenario");
+  return 0;
+}

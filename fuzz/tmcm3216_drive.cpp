@@ -1,0 +1,266 @@
+// The TMCM-3216 as a three-axis CiA-402 drive on its simulated board (ideal motors), driven only
+// through its public API: CAN frames in (a bring-up chosen by one byte: NMT start, a mode and
+// enable operation on some axes; then SDO downloads biased to the drive objects, the PDS
+// commands of table 228 and the modes; uploads; RPDOs with controlwords; SYNC; NMT; any
+// identifier), board inputs (switches, supply, loads) and motion ticks in between.
+//
+// Invariants:
+// - every statusword (6041 of each axis) holds a valid state coding of table 234 and the one of
+//   the axis' PDS state;
+// - an axis whose PDS state has the drive function disabled (not ready, switch on disabled,
+//   ready to switch on, switched on, fault) before and after a tick does not move its motor
+//   (the driver's electrical angle stays);
+// - every frame on 0x580 + node ID is a valid SDO response, at most one per request (as the
+//   canopen_sdo target checks); every frame sent is a classic frame of at most 8 bytes;
+// - every writable numeric object of every axis holds a value inside its row's range.
+#include <fuzzer/FuzzedDataProvider.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include "canopen_checks.h"
+#include "core/cia402/power_drive_system.h"
+#include "sim/tmcm3216_sim_board.h"
+
+namespace {
+
+using namespace motwin;
+using fuzz::check_dictionary_ranges;
+using fuzz::check_sdo_response;
+using fuzz::trace;
+using modules::tmcm3216::Tmcm3216;
+using cia402::PdsState;
+
+constexpr uint8_t kAxes = modules::tmcm3216::kAxisCount;
+
+// The objects a master writes to run the drive (axis 0's index; + 0x800 per axis).
+constexpr uint16_t kDriveObjects[] = {0x6040, 0x6040, 0x6040, 0x6060, 0x6060, 0x607A, 0x60FF, 0x6081, 0x6083,
+                                      0x6084, 0x6085, 0x6098, 0x6099, 0x609A, 0x607C, 0x605A, 0x605D, 0x60C2};
+// Table 228's commands (shutdown, switch on, enable operation, disable voltage, quick stop,
+// disable operation, fault reset) with the mode bits 4..6, 8 (halt) around them.
+constexpr uint16_t kControlwords[] = {0x0006, 0x0007, 0x000F, 0x0000, 0x0002, 0x0007, 0x0080,
+                                      0x001F, 0x000F, 0x010F, 0x005F, 0x003F, 0x000B, 0x008F};
+constexpr int8_t kModes[] = {1, 3, 6, 8, 9, 0, -1, 2, 7};
+
+bool drive_function_disabled(PdsState state) {
+  return state == PdsState::kNotReadyToSwitchOn || state == PdsState::kSwitchOnDisabled ||
+         state == PdsState::kReadyToSwitchOn || state == PdsState::kSwitchedOn || state == PdsState::kFault;
+}
+
+// Table 234: the state a statusword codes, if any.
+bool valid_state_coding(uint16_t sw) {
+  const uint16_t a = sw & 0x4F, b = sw & 0x6F;
+  return a == 0x00 || a == 0x40 || b == 0x21 || b == 0x23 || b == 0x27 || b == 0x07 || a == 0x0F || a == 0x08;
+}
+
+int64_t read_object(Tmcm3216& device, uint16_t index, uint8_t sub) {
+  canopen::ObjectRef ref;
+  if (device.dictionary().find(index, sub, ref) != canopen::SdoAbort::kNone) return -1;
+  return device.dictionary().value(ref);
+}
+
+void check_statuswords(Tmcm3216& device) {
+  for (uint8_t axis = 0; axis < kAxes; ++axis) {
+    const auto sw = static_cast<uint16_t>(read_object(device, static_cast<uint16_t>(0x6041 + axis * 0x800), 0));
+    FUZZ_CHECK(valid_state_coding(sw), "axis %u statusword %04x is no state of table 234", axis, sw);
+    const uint16_t expected = cia402::state_bits(device.drive(axis).state());
+    FUZZ_CHECK((sw & 0x6F) == (expected & 0x6F), "axis %u statusword %04x, PDS state %d codes %04x", axis, sw,
+               static_cast<int>(device.drive(axis).state()), expected);
+  }
+}
+
+// An expedited SDO download of `value` to index/sub with the size of its type (or 4 bytes).
+can::CanFrame sdo_download(Tmcm3216& device, uint16_t index, uint8_t sub, int64_t value) {
+  canopen::ObjectRef ref;
+  uint8_t size = 4;
+  if (device.dictionary().find(index, sub, ref) == canopen::SdoAbort::kNone && canopen::is_numeric(ref.info->type)) {
+    size = canopen::type_size(ref.info->type);
+    if (size > 4) size = 4;
+  }
+  can::CanFrame frame;
+  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
+  frame.dlc = 8;
+  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
+  frame.data[1] = static_cast<uint8_t>(index);
+  frame.data[2] = static_cast<uint8_t>(index >> 8);
+  frame.data[3] = sub;
+  const auto bits = static_cast<uint64_t>(value);
+  for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
+  return frame;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  FuzzedDataProvider in(data, size);
+  auto nvm = std::make_unique<fuzz::Tmcm3216Nvm>();
+  Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
+  fuzz::RecordingCan can;
+  auto board = std::make_unique<sim::Tmcm3216SimBoard>();
+  auto device = std::make_unique<Tmcm3216>(*nvm, can, board->board());
+  device->power_up();
+  can.frames.clear();
+  const auto signals = sim::Tmcm3216SimBoard::signal_table();
+  bool block_upload = false;
+  int ticks_left = 4000;  // 200 ms of motion per input at most
+
+  // A bring-up most inputs start from, as a master does it (frames in): NMT start, a mode and
+  // shutdown / switch on / enable operation on some axes; then anything.
+  const uint8_t bring_up = in.ConsumeIntegral<uint8_t>();
+  std::vector<can::CanFrame> prelude;
+  if ((bring_up & 0x40) == 0) {
+    can::CanFrame start;
+    start.dlc = 2;
+    start.data[0] = 0x01;
+    prelude.push_back(start);
+  }
+  for (uint8_t axis = 0; axis < kAxes; ++axis) {
+    if ((bring_up >> axis & 1) == 0) continue;
+    const auto offset = static_cast<uint16_t>(axis * 0x800);
+    if (bring_up & 0x80) prelude.push_back(sdo_download(*device, static_cast<uint16_t>(0x2005 + axis * 0x200), 0, 3));
+    prelude.push_back(sdo_download(*device, 0x6060 + offset, 0, kModes[(bring_up >> 3) & 7]));
+    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) prelude.push_back(sdo_download(*device, 0x6040 + offset, 0, cw));
+  }
+  for (const can::CanFrame& frame : prelude) {
+    device->receive(frame);
+    device->process(0);
+  }
+  can.frames.clear();
+
+  for (int step = 0; step < 160 && in.remaining_bytes() > 0; ++step) {
+    can::CanFrame frame;
+    bool send = true;
+    bool is_sdo_request = false;
+    switch (in.ConsumeIntegralInRange<int>(0, 11)) {
+      case 0: {  // NMT: mostly start, sometimes the others (reset node rarely)
+        frame.id = 0;
+        frame.dlc = 2;
+        const uint8_t commands[] = {0x01, 0x01, 0x01, 0x80, 0x02, 0x82, 0x81};
+        frame.data[0] = commands[in.ConsumeIntegralInRange<int>(0, 6)];
+        frame.data[1] = in.ConsumeBool() ? 0 : device->node_id();
+        break;
+      }
+      case 1:
+      case 2:
+      case 3: {  // a drive object of some axis
+        const uint16_t base = kDriveObjects[in.ConsumeIntegralInRange<size_t>(0, std::size(kDriveObjects) - 1)];
+        const uint8_t axis = in.ConsumeIntegralInRange<uint8_t>(0, kAxes - 1);
+        const uint8_t sub = base == 0x6099 || base == 0x60C2 ? in.ConsumeIntegralInRange<uint8_t>(1, 2) : 0;
+        int64_t value;
+        if (base == 0x6040) {
+          value = kControlwords[in.ConsumeIntegralInRange<size_t>(0, std::size(kControlwords) - 1)];
+        } else if (base == 0x6060) {
+          value = kModes[in.ConsumeIntegralInRange<size_t>(0, std::size(kModes) - 1)];
+        } else {
+          value = in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(-200'000, 200'000) : in.ConsumeIntegral<int32_t>();
+        }
+        frame = sdo_download(*device, static_cast<uint16_t>(base + axis * 0x800), sub, value);
+        is_sdo_request = true;
+        break;
+      }
+      case 4: {  // any object of the dictionary, any value (downloads) or an upload
+        const auto rows = device->dictionary().rows();
+        const auto& info = rows[in.ConsumeIntegralInRange<size_t>(0, rows.size() - 1)].info;
+        const auto index = static_cast<uint16_t>(info.index + in.ConsumeIntegralInRange<int>(0, kAxes - 1) * info.axis_stride);
+        const int64_t value = in.PickValueInArray({info.min, info.max, info.default_value, info.max + 1, info.min - 1,
+                                                   static_cast<int64_t>(in.ConsumeIntegral<int32_t>())});
+        frame = sdo_download(*device, index, info.sub, value);
+        if (in.ConsumeBool()) frame.data[0] = 0x40;  // initiate upload
+        is_sdo_request = true;
+        break;
+      }
+      case 5: {  // an RPDO of axis 0 (defaults: 6040, 6040+6060, 6040+607A, 6040+60FF)
+        frame.id = in.PickValueInArray({0x200u, 0x300u, 0x400u, 0x500u}) + device->node_id();
+        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8)
+                                                               : in.PickValueInArray({2, 3, 6});
+        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+        const uint16_t cw = kControlwords[in.ConsumeIntegralInRange<size_t>(0, std::size(kControlwords) - 1)];
+        frame.data[0] = static_cast<uint8_t>(cw);
+        frame.data[1] = static_cast<uint8_t>(cw >> 8);
+        if (frame.id == 0x300u + device->node_id()) frame.data[2] = static_cast<uint8_t>(kModes[frame.data[2] % 9]);
+        break;
+      }
+      case 6:  // SYNC
+        frame.id = 0x80;
+        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0;
+        frame.data[0] = in.ConsumeIntegral<uint8_t>();
+        break;
+      case 7: {  // any identifier
+        frame.id = in.ConsumeIntegralInRange<uint32_t>(0, 0x7FF);
+        frame.rtr = in.ConsumeIntegralInRange<int>(0, 7) == 0;
+        frame.dlc = in.ConsumeIntegralInRange<uint8_t>(0, 8);
+        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+        break;
+      }
+      case 8: {  // a board input: switches, supply, temperatures, loads
+        const sim::SignalInfo& signal = signals[in.ConsumeIntegralInRange<size_t>(0, signals.size() - 1)];
+        double value = in.ConsumeFloatingPointInRange<double>(signal.min, signal.max);
+        if (signal.whole_numbers_only) value = static_cast<double>(static_cast<int64_t>(value));
+        if (sim::check_signal_value(signal, value).empty()) board->set_input(signal.name, value);
+        send = false;
+        break;
+      }
+      default: {  // motion ticks
+        send = false;
+        const int ticks = in.ConsumeIntegralInRange<int>(1, 1000);
+        for (int i = 0; i < ticks && ticks_left > 0; ++i, --ticks_left) {
+          PdsState before[kAxes];
+          uint32_t angle[kAxes];
+          for (uint8_t axis = 0; axis < kAxes; ++axis) {
+            before[axis] = device->drive(axis).state();
+            angle[axis] = board->board().axes[axis].drive.electrical_angle;
+          }
+          board->before_tick();
+          device->tick();
+          board->after_tick(modules::tmcm3216::kTickUs * 1e-6);
+          for (uint8_t axis = 0; axis < kAxes; ++axis) {
+            if (drive_function_disabled(before[axis]) && drive_function_disabled(device->drive(axis).state())) {
+              FUZZ_CHECK(board->board().axes[axis].drive.electrical_angle == angle[axis],
+                         "axis %u moved its motor in PDS state %d", axis, static_cast<int>(device->drive(axis).state()));
+            }
+          }
+        }
+        break;
+      }
+    }
+
+    const uint8_t node_before = device->node_id();
+    const bool stopped_before = device->nmt_state() == canopen::NmtState::kStopped;
+    if (send) {
+      trace("->", frame);
+      device->receive(frame);
+      device->process(0);
+    }
+    const uint8_t ccs = frame.data[0] >> 5;
+    if (is_sdo_request && ccs != 5) block_upload = false;
+    size_t responses = 0;
+    for (const can::CanFrame& out : can.frames) {
+      trace("  <-", out);
+      FUZZ_CHECK(out.dlc <= 8 && (out.extended ? out.id <= 0x1FFFFFFF : out.id <= 0x7FF), "frame %x with dlc %u",
+                 out.id, out.dlc);
+      if (!send || out.id != canopen::kSdoResponseCobIdBase + node_before || out.extended) continue;
+      ++responses;
+      check_sdo_response(out, is_sdo_request ? &frame : nullptr, block_upload);
+    }
+    FUZZ_CHECK(responses <= 1, "%zu SDO responses to one frame", responses);
+    if (stopped_before && device->nmt_state() == canopen::NmtState::kStopped) {
+      FUZZ_CHECK(responses == 0, "an SDO response while the node is stopped");
+    }
+    can.frames.clear();
+    check_statuswords(*device);
+    if (step % 16 == 15) check_dictionary_ranges(*device);
+  }
+  check_dictionary_ranges(*device);
+  if (std::getenv("MOTWIN_FUZZ_TRACE") != nullptr) {
+    for (uint8_t axis = 0; axis < kAxes; ++axis) {
+      std::fprintf(stderr, "axis %u: PDS state %d, mode %d, position %d\n", axis,
+                   static_cast<int>(device->drive(axis).state()), device->drive(axis).mode_display(),
+                   device->drive(axis).position_demand());
+    }
+  }
+  return 0;
+}
