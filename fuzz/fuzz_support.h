@@ -83,9 +83,10 @@ inline std::vector<int32_t> probe_parameters(Tmcm1636& module) {
   return values;
 }
 
-// A writable parameter holds a value inside its row's range, whatever came before.
-inline void check_parameter_ranges(Tmcm1636& module, const char* when) {
-  for (const auto& row : Tmcm1636::axis_parameters().rows()) {
+// A writable axis parameter (motor 0) holds a value inside its row's range, whatever came before.
+template <typename Module>
+void check_axis_parameter_ranges(Module& module, const char* when) {
+  for (const auto& row : Module::axis_parameters().rows()) {
     if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
       continue;
     }
@@ -95,7 +96,12 @@ inline void check_parameter_ranges(Tmcm1636& module, const char* when) {
                row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
                static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
   }
-  for (const auto& row : Tmcm1636::global_parameters().rows()) {
+}
+
+// The same for the writable global parameters of bank 0.
+template <typename Module>
+void check_global_parameter_ranges(Module& module, const char* when) {
+  for (const auto& row : Module::global_parameters().rows()) {
     if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
       continue;
     }
@@ -105,6 +111,13 @@ inline void check_parameter_ranges(Tmcm1636& module, const char* when) {
                row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
                static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
   }
+}
+
+// A TMCL module (TMCM-1636, TMCM-142): every writable parameter within its range.
+template <typename Module>
+void check_parameter_ranges(Module& module, const char* when) {
+  check_axis_parameter_ranges(module, when);
+  check_global_parameter_ranges(module, when);
 }
 
 // Keeps what the module sends; the fuzz targets inspect it after each process() call.

@@ -32,6 +32,7 @@
 #include "core/modules/tmcm142/tmcm142.h"
 #include "core/tmcl/instruction.h"
 #include "fuzz_support.h"
+#include "scenario_checks.h"
 #include "sim/scenario.h"
 #include "sim/stepper_motor_selection.h"
 #include "sim/tmcm142_sim_board.h"
@@ -66,40 +67,6 @@ void check_motor(const sim::StepperMotorChoice& choice) {
              sim::StepperPlant::step_number(m, sub_step_s));
 }
 
-void check_events(const sim::ScenarioParseResult& result, std::string_view text) {
-  const auto signals = sim::Tmcm142SimBoard::signal_table();
-  size_t lines = 1;
-  for (char c : text) lines += c == '\n' ? 1 : 0;
-  for (size_t i = 0; i < result.events.size(); ++i) {
-    const sim::ScenarioEvent& event = result.events[i];
-    const sim::SignalInfo* signal = sim::find_signal(signals, event.signal);
-    FUZZ_CHECK(signal != nullptr && signal->name == event.signal, "event signal '%s'", event.signal.c_str());
-    FUZZ_CHECK(std::isfinite(event.value) && sim::check_signal_value(*signal, event.value).empty(), "%s = %g",
-               event.signal.c_str(), event.value);
-    FUZZ_CHECK(event.time_us <= static_cast<uint64_t>(sim::kMaxScenarioTimeS * 1e6), "time %llu us",
-               static_cast<unsigned long long>(event.time_us));
-    FUZZ_CHECK(event.line >= 1 && event.line <= lines, "line %zu of %zu", event.line, lines);
-    if (i > 0) {
-      const sim::ScenarioEvent& previous = result.events[i - 1];
-      FUZZ_CHECK(previous.time_us < event.time_us || (previous.time_us == event.time_us && previous.line < event.line),
-                 "events %zu and %zu out of order", i - 1, i);
-    }
-  }
-}
-
-void check_axis_parameters(Tmcm142& module, const char* when) {
-  for (const auto& row : Tmcm142::axis_parameters().rows()) {
-    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
-      continue;
-    }
-    int32_t value = 0;
-    if (module.get_axis_parameter(static_cast<uint8_t>(row.info.number), 0, value) != tmcl::Status::kOk) continue;
-    FUZZ_CHECK(params::in_range(row.info, value), "%s: AP %u (%.*s) holds %d, range %lld..%lld", when,
-               row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
-               static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
-  }
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -117,7 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(events.error.rfind("fuzz.scn:", 0) == 0, "error without its source: %s", events.error.c_str());
     events.events.clear();
   }
-  check_events(events, scenario);
+  fuzz::check_scenario_events(events, scenario, sim::Tmcm142SimBoard::signal_table());
   if (std::getenv("MOTWIN_FUZZ_TRACE") != nullptr) {  // for reading a saved input
     std::fprintf(stderr, "motor: %s; scenario: %zu events %s\n", motor.motor ? motor.motor->name.c_str() : motor.error.c_str(),
                  events.events.size(), events.error.c_str());
@@ -172,13 +139,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const auto value = board->read_signal(name);
       FUZZ_CHECK(!value || std::isfinite(*value), "%s is %g after tick %u", name, *value, tick);
     }
-    if (tick % 500 == 499) check_axis_parameters(*module, "while running");
+    if (tick % 500 == 499) fuzz::check_axis_parameter_ranges(*module, "while running");
   }
   const size_t applied_on_time = player.applied_count();
   const size_t applied_late = player.apply_due(UINT64_MAX);
   FUZZ_CHECK(applied_on_time + applied_late == event_count && player.finished(), "not every event was applied");
   board->before_tick();
   module->tick();
-  check_axis_parameters(*module, "after the scenario");
+  fuzz::check_axis_parameter_ranges(*module, "after the scenario");
   return 0;
 }

@@ -6,40 +6,14 @@
 #include <cmath>
 
 #include "core/cia402/axis_drive.h"
+#include "support/cia402_axis_rig.h"
 
 namespace motwin::cia402 {
 namespace {
 
-constexpr uint32_t kTickUs = 50;
+constexpr uint32_t kTickUs = testing::Cia402AxisRig::kTickUs;
 
-struct Axis {
-  AxisDrive drive;
-  AxisInputs inputs;
-  Axis() { drive.reset(0); }
-  void enable(int8_t mode) {
-    drive.objects.mode = mode;
-    drive.write_controlword(0x06);
-    drive.write_controlword(0x07);
-    drive.write_controlword(0x0F);
-    run_ms(1);
-  }
-  void run_ticks(int n) {
-    for (int i = 0; i < n; ++i) {
-      if (drive.objects.sensor_selection == 0) inputs.encoder_position_usteps = drive.position_demand();
-      drive.step(inputs, kTickUs);
-    }
-  }
-  void run_ms(double ms) { run_ticks(static_cast<int>(ms * 1000 / kTickUs)); }
-  // Runs until `done` or the time runs out; returns the elapsed time in s (or -1).
-  template <class F>
-  double run_until(F done, double max_s) {
-    const int max_ticks = static_cast<int>(max_s * 1e6 / kTickUs);
-    for (int i = 0; i < max_ticks; ++i) {
-      run_ticks(1);
-      if (done()) return (i + 1) * kTickUs * 1e-6;
-    }
-    return -1;
-  }
+struct Axis : testing::Cia402AxisRig {
   std::vector<AxisEmergency> emergencies() {
     std::vector<AxisEmergency> out;
     AxisEmergency e;

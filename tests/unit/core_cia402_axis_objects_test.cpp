@@ -8,41 +8,14 @@
 #include <cmath>
 
 #include "core/cia402/axis_drive.h"
+#include "support/cia402_axis_rig.h"
 
 namespace motwin::cia402 {
 namespace {
 
-constexpr uint32_t kTickUs = 50;
-
-struct Axis {
-  AxisDrive drive;
-  AxisInputs inputs;
-  // With 606A = 0 the encoder reads the demand minus this lag (a motor behind its field).
-  int32_t encoder_lag = 0;
-  Axis() { drive.reset(0); }
-  void enable(int8_t mode) {
-    drive.objects.mode = mode;
-    drive.write_controlword(0x06);
-    drive.write_controlword(0x07);
-    drive.write_controlword(0x0F);
-    run_ms(1);
-  }
-  void run_ticks(int n) {
-    for (int i = 0; i < n; ++i) {
-      inputs.encoder_position_usteps = drive.position_demand() - encoder_lag;
-      drive.step(inputs, kTickUs);
-    }
-  }
-  void run_ms(double ms) { run_ticks(static_cast<int>(std::lround(ms * 1000 / kTickUs))); }
-  template <class F>
-  double run_until(F done, double max_s) {
-    const int max_ticks = static_cast<int>(max_s * 1e6 / kTickUs);
-    for (int i = 0; i < max_ticks; ++i) {
-      run_ticks(1);
-      if (done()) return (i + 1) * kTickUs * 1e-6;
-    }
-    return -1;
-  }
+struct Axis : testing::Cia402AxisRig {
+  // With 606A = 0 or -1 alike the encoder reads the demand minus encoder_lag.
+  Axis() { encoder_always_follows = true; }
   void new_set_point(int32_t target, uint16_t extra_bits = 0) {
     drive.objects.target_position = target;
     drive.write_controlword(static_cast<uint16_t>(0x1F | extra_bits));

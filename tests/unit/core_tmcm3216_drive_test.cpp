@@ -15,79 +15,20 @@
 #include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "sim/tmcm3216_sim_board.h"
+#include "support/tmcm3216_board_rig.h"
 
 namespace motwin::modules::tmcm3216 {
 namespace {
 
-class Recorder final : public board::CanController {
- public:
-  std::vector<can::CanFrame> frames;
-  bool transmit(const can::CanFrame& frame) override {
-    frames.push_back(frame);
-    return true;
-  }
-};
-
-using Nvm = board::RamNonVolatileMemory<Tmcm3216::kNvmSize>;
-
-struct Rig {
-  std::unique_ptr<Nvm> nvm = std::make_unique<Nvm>();
-  Recorder can;
-  sim::Tmcm3216SimBoard board;
-  std::unique_ptr<Tmcm3216> device;
-
-  explicit Rig(const sim::StepperMotorDescription& motor) : board(motor) { start(); }
-  Rig() { start(); }
-  void start() {
-    Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
-    device = std::make_unique<Tmcm3216>(*nvm, can, board.board());
-    device->power_up();
-  }
+struct Rig : testing::Tmcm3216BoardRig {
+  using Tmcm3216BoardRig::Tmcm3216BoardRig;
   int64_t read(uint16_t index, uint8_t sub = 0) {
     canopen::ObjectRef ref;
     EXPECT_EQ(device->dictionary().find(index, sub, ref), canopen::SdoAbort::kNone) << std::hex << index;
     if (ref.info == nullptr) return 0;
     return device->dictionary().value(ref);
   }
-  canopen::SdoAbort write(uint16_t index, uint8_t sub, int64_t value) {
-    canopen::ObjectRef ref;
-    if (const canopen::SdoAbort abort = device->dictionary().find(index, sub, ref); abort != canopen::SdoAbort::kNone) {
-      return abort;
-    }
-    uint8_t data[4] = {};
-    canopen::encode_value(ref.info->type, value, data);
-    return device->dictionary().write(ref, data, canopen::type_size(ref.info->type));
-  }
-  void nmt(uint8_t command) {
-    can::CanFrame frame;
-    frame.id = 0;
-    frame.dlc = 2;
-    frame.data[0] = command;
-    frame.data[1] = 0;
-    device->receive(frame);
-  }
-  void sync() {
-    can::CanFrame frame;
-    frame.id = 0x80;
-    frame.dlc = 0;
-    device->receive(frame);
-  }
-  void tick(uint64_t n = 1) {
-    for (uint64_t i = 0; i < n; ++i) {
-      board.before_tick();
-      device->tick();
-      board.after_tick(kTickUs * 1e-6);
-    }
-  }
-  void run_ms(double ms) { tick(static_cast<uint64_t>(ms * 1000 / kTickUs)); }
-  std::vector<can::CanFrame> emergencies() {
-    std::vector<can::CanFrame> out;
-    for (const can::CanFrame& f : can.frames) {
-      if (f.id == 0x81) out.push_back(f);
-    }
-    can.frames.clear();
-    return out;
-  }
+  canopen::SdoAbort write(uint16_t index, uint8_t sub, int64_t value) { return write_object(index, sub, value); }
   void enable(uint16_t offset, int8_t mode) {
     ASSERT_EQ(write(0x6060 + offset, 0, mode), canopen::SdoAbort::kNone);
     ASSERT_EQ(write(0x6040 + offset, 0, 6), canopen::SdoAbort::kNone);

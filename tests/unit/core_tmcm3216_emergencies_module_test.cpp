@@ -17,34 +17,16 @@
 #include "host/module_registry.h"
 #include "host/tmcm3216_virtual_module.h"
 #include "sim/tmcm3216_sim_board.h"
+#include "support/tmcm3216_board_rig.h"
 
 namespace motwin::modules::tmcm3216 {
 namespace {
 
-class EmcyRecorder final : public board::CanController {
- public:
-  std::vector<can::CanFrame> frames;
-  board::CanControllerStatus can_status;  // what the controller reports (fault confinement)
-  bool transmit(const can::CanFrame& frame) override {
-    frames.push_back(frame);
-    return true;
-  }
-  board::CanControllerStatus status() const override { return can_status; }
-};
-
-using Nvm = board::RamNonVolatileMemory<Tmcm3216::kNvmSize>;
 using Bytes = std::array<uint8_t, 8>;
 
-struct EmcyRig {
-  std::unique_ptr<Nvm> nvm = std::make_unique<Nvm>();
-  EmcyRecorder can;
-  sim::Tmcm3216SimBoard board;
-  std::unique_ptr<Tmcm3216> device;
-
+// Operational, with the EMCY frames of the start-up read.
+struct EmcyRig : testing::Tmcm3216BoardRig {
   EmcyRig() {
-    Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
-    device = std::make_unique<Tmcm3216>(*nvm, can, board.board());
-    device->power_up();
     nmt(0x01);  // operational
     run_ms(2);
     emergencies();
@@ -57,30 +39,7 @@ struct EmcyRig {
   void write(uint16_t index, int64_t value, uint8_t sub = 0) {
     canopen::ObjectRef ref;
     ASSERT_EQ(device->dictionary().find(index, sub, ref), canopen::SdoAbort::kNone);
-    uint8_t data[4] = {};
-    canopen::encode_value(ref.info->type, value, data);
-    ASSERT_EQ(device->dictionary().write(ref, data, canopen::type_size(ref.info->type)), canopen::SdoAbort::kNone);
-  }
-  void nmt(uint8_t command) {
-    can::CanFrame frame;
-    frame.dlc = 2;
-    frame.data[0] = command;
-    device->receive(frame);
-  }
-  void run_ms(double ms) {
-    for (uint64_t i = 0; i < static_cast<uint64_t>(ms * 1000 / kTickUs); ++i) {
-      board.before_tick();
-      device->tick();
-      board.after_tick(kTickUs * 1e-6);
-    }
-  }
-  std::vector<can::CanFrame> emergencies() {
-    std::vector<can::CanFrame> out;
-    for (const can::CanFrame& f : can.frames) {
-      if (f.id == 0x81) out.push_back(f);
-    }
-    can.frames.clear();
-    return out;
+    ASSERT_EQ(write_object(index, sub, value), canopen::SdoAbort::kNone);
   }
   void enable(uint16_t offset) {
     write(0x6060 + offset, 3);
