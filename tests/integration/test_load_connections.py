@@ -18,6 +18,7 @@ harness's 2 s reply timeout, while the load runs.
 """
 
 import os
+import select
 import socket
 import struct
 import sys
@@ -247,21 +248,33 @@ def test_pty_frame_flood(motwin):
                     request = frame(GGP, 9, BANK_USER)
 
                     def pty_flood():
-                        # Read while writing, as a serial client does: the server stops reading
-                        # while its replies back up (back-pressure), so a client that writes
-                        # everything before reading anything could block both sides.
-                        received = {}
-                        reader = threading.Thread(
-                            target=lambda: received.update(data=c.read_exact(9 * count, timeout=120.0)), daemon=True)
-                        reader.start()
-                        c.send_raw(request * count)
-                        reader.join(125.0)
-                        data = received.get("data", b"")
+                        # Write the flood and read the replies in one loop on the raw descriptor,
+                        # reading whenever anything is there, as a serial client does: the server
+                        # stops reading while its replies back up (back-pressure), so a client that
+                        # writes everything before reading (or blocks in a drain) can stall both sides.
+                        fd = c.port.fd
+                        pending = request * count
+                        data = b""
+                        deadline = time.monotonic() + 120.0
+                        os.set_blocking(fd, False)
+                        try:
+                            while len(data) < 9 * count and time.monotonic() < deadline:
+                                readable, writable, _ = select.select([fd], [fd] if pending else [], [], 1.0)
+                                if readable:
+                                    data += os.read(fd, 65536)
+                                if writable and pending:
+                                    try:
+                                        pending = pending[os.write(fd, pending[:4096]):]
+                                    except BlockingIOError:
+                                        pass
+                        finally:
+                            os.set_blocking(fd, True)
+                        check(len(data) == 9 * count, f"pty flood: {len(data)} of {9 * count} reply bytes in 120 s")
                         replies = [parse_reply(data[i:i + 9]) for i in range(0, len(data), 9)]
                         for r in replies:
                             check((r.status, r.command) == (STATUS_OK, GGP), f"pty flood reply {r.raw.hex(' ')}")
                         c.expect_no_reply(0.2, "after the pty flood")
-                        return f"{count} frames in one write, {len(replies)} replies"
+                        return f"{count} frames written in 4 KiB pieces, {len(replies)} replies"
 
                     rounds, note = run_with_good_client(pty_flood, lambda i: good_round(good, i), memory)
                     print(f"  {note}; well-behaved TCP client: {rounds} rounds meanwhile", flush=True)
