@@ -6,13 +6,15 @@
 
 namespace motwin::host {
 
-// Runs `count` ticks from `tick_count` on and returns the new tick count. Output changes are
-// stamped (through `output_clock.set_sim_time_us`) with the start of the tick that made them;
-// afterwards the clock stands at the end of the last tick. `tick_s` is passed apart from
-// `tick_us` so that each module integrates with the very constant its firmware uses.
+// Runs `count` ticks, advancing the module's `tick_count` after each one: what reads the module's
+// clock during a tick (the CAN bus stamping a frame the firmware sends, its bit-time and
+// error-recovery accounting) sees the time of that tick, not of the batch's start. Output
+// changes are stamped (through `output_clock.set_sim_time_us`) with the start of the tick that
+// made them; afterwards the clock stands at the end of the last tick. `tick_s` is passed apart
+// from `tick_us` so that each module integrates with the very constant its firmware uses.
 template <typename SimBoard, typename Device, typename OutputClock>
-uint64_t run_board_ticks(uint64_t count, uint64_t tick_count, uint32_t tick_us, double tick_s, SimBoard& sim_board,
-                         Device& device, OutputClock& output_clock) {
+void run_board_ticks(uint64_t count, uint64_t& tick_count, uint32_t tick_us, double tick_s, SimBoard& sim_board,
+                     Device& device, OutputClock& output_clock) {
   for (uint64_t i = 0; i < count; ++i) {
     output_clock.set_sim_time_us(tick_count * tick_us);
     sim_board.before_tick();
@@ -21,7 +23,6 @@ uint64_t run_board_ticks(uint64_t count, uint64_t tick_count, uint32_t tick_us, 
     ++tick_count;
   }
   output_clock.set_sim_time_us(tick_count * tick_us);
-  return tick_count;
 }
 
 }  // namespace motwin::host

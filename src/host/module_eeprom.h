@@ -15,10 +15,21 @@
 
 namespace motwin::host {
 
+// The size of a module's image: its parameter layout's (the TMCL modules) or, for a module
+// without one (the TMCM-3216's CANopen storage image), Device::kNvmSize.
+template <typename Device>
+constexpr size_t nvm_image_size_of() {
+  if constexpr (requires { Device::kNvmLayout.total_size; }) {
+    return Device::kNvmLayout.total_size;
+  } else {
+    return Device::kNvmSize;
+  }
+}
+
 // What a module's image file is checked against: the module's name, layout version and size.
 template <typename Device>
 EepromImageIdentity eeprom_identity_of() {
-  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, Device::kNvmLayout.total_size};
+  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, nvm_image_size_of<Device>()};
 }
 
 template <size_t kImageSize>

@@ -37,7 +37,7 @@ class TmclSimModule : public VirtualModule {
   TmclCanNode* tmcl_can_node() override { return &*can_; }
   uint32_t tick_period_us() const override { return kTickUs; }
   void run_ticks(uint64_t count) override {
-    tick_count_ = run_board_ticks(count, tick_count_, kTickUs, kTickS, *board_, *device_, io_);
+    run_board_ticks(count, tick_count_, kTickUs, kTickS, *board_, *device_, io_);
   }
   uint64_t tick_count() const override { return tick_count_; }
   board::NonVolatileMemory& nvm() override { return eeprom_.nvm(); }

@@ -2,13 +2,10 @@
 
 #include <cstdlib>
 
+#include "host/board_ticks.h"
 #include "sim/stepper_motor_selection.h"
 
 namespace motwin::host {
-
-EepromImageIdentity Tmcm3216VirtualModule::eeprom_identity() {
-  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, Device::kNvmSize};
-}
 
 std::span<const sim::SignalInfo> Tmcm3216VirtualModule::signal_table() { return sim::Tmcm3216SimBoard::signal_table(); }
 
@@ -19,35 +16,21 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
     return result;
   }
   // The motor is checked before any file is touched.
-  sim::StepperMotorChoice motor = sim::resolve_stepper_motor(options.motor);
+  sim::StepperMotorChoices motor = sim::resolve_stepper_motors(options.motor, sim::Tmcm3216SimBoard::kAxisCount);
   if (!motor.error.empty()) {
     result.error = motor.error;
     return result;
   }
   std::unique_ptr<Tmcm3216VirtualModule> module(new Tmcm3216VirtualModule());
-  if (options.state_dir) {
-    EepromFile::OpenResult opened =
-        EepromFile::open(*options.state_dir, eeprom_identity(), &Device::format_factory_image, options.log);
-    if (!opened.file) {
-      result.error = opened.error;
-      return result;
-    }
-    module->eeprom_file_ = std::move(opened.file);
-    module->nvm_ = module->eeprom_file_.get();
-  } else {
-    module->memory_image_ = std::make_unique<MemoryImage>();
-    Device::format_factory_image(module->memory_image_->mutable_data(), module->memory_image_->size());
-    module->nvm_ = module->memory_image_.get();
-  }
+  if (!module->eeprom_.open(options, eeprom_identity(), &Device::format_factory_image, result.error)) return result;
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
   config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
-  module->board_ = motor.motor ? std::make_unique<sim::Tmcm3216SimBoard>(*motor.motor)
-                               : std::make_unique<sim::Tmcm3216SimBoard>();
+  module->board_ = std::make_unique<sim::Tmcm3216SimBoard>(motor.motors);
   for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
   module->board_->before_tick();
   board::CanController& controller = *module;  // private base: reachable here only
-  module->device_ = std::make_unique<Device>(*module->nvm_, controller, module->board_->board(), config);
+  module->device_ = std::make_unique<Device>(module->eeprom_.nvm(), controller, module->board_->board(), config);
   // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a
   // master joins later. Masters send an NMT reset to see one (docs/canopen.md).
   module->device_->power_up();
@@ -60,22 +43,8 @@ Tmcm3216VirtualModule::~Tmcm3216VirtualModule() { disconnect(); }
 tmcl::TmclEngine& Tmcm3216VirtualModule::engine() { std::abort(); }
 
 void Tmcm3216VirtualModule::run_ticks(uint64_t count) {
-  Device& device = *device_;
-  sim::Tmcm3216SimBoard& sim_board = *board_;
   constexpr double kTickS = modules::tmcm3216::kTickUs * 1e-6;
-  for (uint64_t i = 0; i < count; ++i) {
-    // Output changes are stamped with the start of the tick that made them.
-    sim_board.set_sim_time_us(tick_count_ * modules::tmcm3216::kTickUs);
-    sim_board.before_tick();
-    device.tick();
-    sim_board.after_tick(kTickS);
-    ++tick_count_;
-  }
-  sim_board.set_sim_time_us(tick_count_ * modules::tmcm3216::kTickUs);
-}
-
-std::string Tmcm3216VirtualModule::nvm_location() const {
-  return eeprom_file_ ? eeprom_file_->path().string() : "none";
+  run_board_ticks(count, tick_count_, modules::tmcm3216::kTickUs, kTickS, *board_, *device_, *board_);
 }
 
 void Tmcm3216VirtualModule::connect(CanBus& bus) {

@@ -9,10 +9,9 @@
 #include <optional>
 
 #include "board/can_controller.h"
-#include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "host/can_bus.h"
-#include "host/eeprom_file.h"
+#include "host/module_eeprom.h"
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
 #include "sim/signals.h"
@@ -23,9 +22,8 @@ namespace motwin::host {
 class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, private board::CanController {
  public:
   using Device = modules::tmcm3216::Tmcm3216;
-  using MemoryImage = board::RamNonVolatileMemory<Device::kNvmSize>;
 
-  static EepromImageIdentity eeprom_identity();
+  static EepromImageIdentity eeprom_identity() { return eeprom_identity_of<Device>(); }
   static std::span<const sim::SignalInfo> signal_table();
   static MakeModuleResult make(const ModuleOptions& options);
 
@@ -42,8 +40,8 @@ class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, pri
   uint32_t tick_period_us() const override { return modules::tmcm3216::kTickUs; }
   void run_ticks(uint64_t count) override;
   uint64_t tick_count() const override { return tick_count_; }
-  board::NonVolatileMemory& nvm() override { return *nvm_; }
-  std::string nvm_location() const override;
+  board::NonVolatileMemory& nvm() override { return eeprom_.nvm(); }
+  std::string nvm_location() const override { return eeprom_.location(); }
   sim::SignalBoard& signals() override { return *board_; }
 
   // CanBusNode.
@@ -66,9 +64,7 @@ class Tmcm3216VirtualModule final : public VirtualModule, public CanBusNode, pri
 
   // Before device_: the device keeps a reference to its board seam.
   std::unique_ptr<sim::Tmcm3216SimBoard> board_;
-  std::unique_ptr<EepromFile> eeprom_file_;
-  std::unique_ptr<MemoryImage> memory_image_;
-  board::NonVolatileMemory* nvm_ = nullptr;
+  ModuleEeprom<nvm_image_size_of<Device>()> eeprom_;  // before device_, which keeps its nvm()
   std::unique_ptr<Device> device_;
   CanBus* bus_ = nullptr;
   CanBus::EndpointId bus_id_ = 0;

@@ -208,6 +208,35 @@ TEST(Slcan, session_follows_the_lawicel_command_set) {
   EXPECT_EQ(sent.size(), 2u);
 }
 
+// The bus reads the module's clock when the firmware sends: frames sent during one run_ticks()
+// batch carry the time of their own tick, not the batch's start (bit-rate accounting and bus-off
+// recovery depend on it). A 1 ms heartbeat over one 20 ms batch: 1 ms apart.
+TEST(CanBus, frames_sent_within_one_batch_of_ticks_carry_their_own_tick_time) {
+  ModuleOptions options;
+  options.node_id = 4;
+  options.log = [](const std::string&) {};
+  MakeModuleResult made = make_module("tmcm-3216", options);
+  ASSERT_TRUE(made.module) << made.error;
+  VirtualModule& module = *made.module;
+  CanBus bus([&module] { return module.sim_time_us(); });
+  Recorder master;
+  const CanBus::EndpointId master_id = bus.attach(master);
+  module.can_node()->connect(bus);
+  bus.send(master_id, frame(0x604, {0x2B, 0x17, 0x10, 0x00, 0x01, 0x00, 0, 0}));  // 1017 = 1 ms
+  module.run_ticks(1);
+  master.frames.clear();
+  master.stamps.clear();
+  module.run_ticks(20'000 / module.tick_period_us());
+  std::vector<uint64_t> heartbeats;
+  for (size_t n = 0; n < master.frames.size(); ++n) {
+    if (master.frames[n].id == 0x704) heartbeats.push_back(master.stamps[n]);
+  }
+  ASSERT_GE(heartbeats.size(), 19u);
+  for (size_t n = 1; n < heartbeats.size(); ++n) EXPECT_EQ(heartbeats[n] - heartbeats[n - 1], 1000u) << n;
+  EXPECT_LE(heartbeats.back(), module.sim_time_us());
+  module.can_node()->disconnect();
+}
+
 // The whole path: a TCP client, the socketcand server, the bus and the TMCM-3216.
 TEST(SocketcandServer, serves_an_sdo_exchange_and_never_echoes) {
   ModuleOptions options;
