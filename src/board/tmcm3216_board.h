@@ -25,6 +25,9 @@ struct Tmcm3216Io {
   std::array<bool, kDioCount> dio_levels{};
   std::array<uint16_t, kAnalogInputCount> analog_inputs{};  // raw 12-bit counts
   int32_t supply_millivolt = 24000;
+  // The enable signal of the module's shutdown switch (manual table 365, 5441): false while the
+  // switch is open; the hardware then keeps every motor driver off.
+  bool enable_input = true;
 
   // Written by the firmware each tick. output_mode: 2711 bit n (the pin is driven);
   // push_pull: 2711 bit 8 + n (else high side: only a high level is driven, low floats).

@@ -490,7 +490,8 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "a preset (default-24v, large-48v, dc-24v: physical models driven by the firmware's "
                     "regulators; a new EEPROM image gets the preset's start-up settings) or a motor description "
                     "file (.json). See docs/tmcm-1636-servo.md. The tmcm-142 takes ideal, nema17, nema23 or a stepper "
-                    "description file (docs/tmcm-142.md)")
+                    "description file (docs/tmcm-142.md); the tmcm-3216 takes one of those for all three axes or a "
+                    "comma-separated list, one per axis, e.g. nema17,ideal,nema23 (docs/tmcm-3216-drive.md)")
       ->type_name(motor_names + "|FILE")
       ->capture_default_str();
   serve->add_option("--scenario", arguments->scenario_path,

@@ -146,4 +146,56 @@ StepperMotorChoice resolve_stepper_motor(std::string_view name_or_path) {
   return parse_stepper_motor_description(text.str(), path);
 }
 
+namespace {
+
+std::string_view trimmed(std::string_view text) {
+  while (!text.empty() && (text.front() == ' ' || text.front() == '\t')) text.remove_prefix(1);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\t')) text.remove_suffix(1);
+  return text;
+}
+
+}  // namespace
+
+StepperMotorChoices resolve_stepper_motors(std::string_view list, size_t axis_count) {
+  StepperMotorChoices result;
+  if (list.find(',') == std::string_view::npos) {
+    // One motor for all axes, as before per-axis lists (also "" = ideal).
+    StepperMotorChoice single = resolve_stepper_motor(trimmed(list));
+    if (!single.error.empty()) {
+      result.error = std::move(single.error);
+      return result;
+    }
+    result.motors.assign(axis_count, single.motor);
+    return result;
+  }
+  std::vector<std::string_view> items;
+  for (size_t start = 0;;) {
+    const size_t comma = list.find(',', start);
+    items.push_back(trimmed(list.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  if (items.size() != axis_count) {
+    result.error = "--motor \"" + std::string(list) + "\" names " + std::to_string(items.size()) + " motors for " +
+                   std::to_string(axis_count) + " axes (give one motor for all axes, or one per axis separated by commas)";
+    return result;
+  }
+  for (size_t axis = 0; axis < items.size(); ++axis) {
+    const std::string prefix = "motor of axis " + std::to_string(axis) + ": ";
+    if (items[axis].empty()) {
+      result.error = prefix + "empty name (expected " + preset_list() + " or a .json stepper description)";
+      result.motors.clear();
+      return result;
+    }
+    StepperMotorChoice choice = resolve_stepper_motor(items[axis]);
+    if (!choice.error.empty()) {
+      result.error = prefix + choice.error;
+      result.motors.clear();
+      return result;
+    }
+    result.motors.push_back(std::move(choice.motor));
+  }
+  return result;
+}
+
 }  // namespace motwin::sim

@@ -15,9 +15,11 @@ constexpr SignalInfo kDeviceSignals[] = {
     {"AIN0", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 0 (270E sub 1)"},
     {"AIN1", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 1 (270E sub 2)"},
     {"VSUPPLY", 0, 60, false, "motor supply voltage in volts (below 8 V the drivers flag undervoltage)"},
+    {"ENABLE", 0, 1, true,
+     "enable signal of the shutdown switch, default 1; 0: all drivers off, EMCY 5441, every axis to FAULT"},
 };
-enum DeviceSignal : size_t { kDio0, kAin0 = kDio0 + 4, kAin1, kVsupply };
-static_assert(kVsupply + 1 == std::size(kDeviceSignals));
+enum DeviceSignal : size_t { kDio0, kAin0 = kDio0 + 4, kAin1, kVsupply, kEnable };
+static_assert(kEnable + 1 == std::size(kDeviceSignals));
 
 // Per axis, named AXIS<n>_<suffix>.
 struct AxisSignalInfo {
@@ -126,10 +128,15 @@ Tmcm3216SimBoard::Tmcm3216SimBoard() {
   before_tick();
 }
 
-Tmcm3216SimBoard::Tmcm3216SimBoard(const StepperMotorDescription& motor, int sub_steps) {
+Tmcm3216SimBoard::Tmcm3216SimBoard(const StepperMotorDescription& motor, int sub_steps)
+    : Tmcm3216SimBoard(std::array<std::optional<StepperMotorDescription>, kAxisCount>{motor, motor, motor}, sub_steps) {}
+
+Tmcm3216SimBoard::Tmcm3216SimBoard(std::span<const std::optional<StepperMotorDescription>> motors, int sub_steps) {
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
-    axes_[axis].plant = std::make_unique<StepperPlant>(motor, sub_steps);
-    axes_[axis].ideal.full_steps_per_revolution = motor.full_steps_per_revolution;
+    if (axis < motors.size() && motors[axis]) {
+      axes_[axis].plant = std::make_unique<StepperPlant>(*motors[axis], sub_steps);
+      axes_[axis].ideal.full_steps_per_revolution = motors[axis]->full_steps_per_revolution;
+    }
     apply_sensor_config(axis);
   }
   before_tick();
@@ -175,6 +182,7 @@ void Tmcm3216SimBoard::before_tick() {
   for (uint8_t n = 0; n < board::Tmcm3216Io::kDioCount; ++n) io.dio_levels[n] = pin_level(n);
   io.analog_inputs = analog_raw_;
   io.supply_millivolt = supply_millivolt_;
+  io.enable_input = enable_input_;
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) sense_axis(axis);
 }
 
@@ -213,8 +221,12 @@ void Tmcm3216SimBoard::after_tick(double dt_s) {
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
     Axis& a = axes_[axis];
     board::StepperDrive drive = board_.axes[axis].drive;
-    // The chip's protections switch the bridges off; an open coil carries no current.
-    if (a.short_circuit || a.driver_celsius >= kOvertemperatureCelsius || supply_millivolt_ < 8000) drive.enabled = false;
+    // The chip's protections switch the bridges off, and so does the shutdown switch (its enable
+    // signal gates every driver in hardware, whatever the firmware asks); an open coil carries no
+    // current.
+    if (a.short_circuit || a.driver_celsius >= kOvertemperatureCelsius || supply_millivolt_ < 8000 || !enable_input_) {
+      drive.enabled = false;
+    }
     if (a.open_coil_a) drive.coil_a_ma = 0;
     if (a.open_coil_b) drive.coil_b_ma = 0;
     const StallGuardSettings settings{drive.stealth_chop, drive.stallguard2_threshold, drive.stallguard2_filter,
@@ -251,8 +263,10 @@ void Tmcm3216SimBoard::set_input(std::string_view name, double value) {
       dio_external_[index - kDio0] = value != 0;
     } else if (index == kAin0 || index == kAin1) {
       analog_raw_[index - kAin0] = static_cast<uint16_t>(std::lround(value));
-    } else {
+    } else if (index == kVsupply) {
       supply_millivolt_ = static_cast<int32_t>(std::lround(value * 1000.0));
+    } else {
+      enable_input_ = value != 0;
     }
     return;
   }
@@ -331,6 +345,7 @@ std::optional<double> Tmcm3216SimBoard::read_signal(std::string_view name) const
     const auto index = static_cast<size_t>(device - kDeviceSignals);
     if (index < kAin0) return pin_level(static_cast<uint8_t>(index - kDio0)) ? 1.0 : 0.0;
     if (index == kAin0 || index == kAin1) return analog_raw_[index - kAin0];
+    if (index == kEnable) return enable_input_ ? 1.0 : 0.0;
     return supply_millivolt_ * 1e-3;
   }
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {

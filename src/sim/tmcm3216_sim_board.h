@@ -3,7 +3,7 @@
 // (ABN encoder with N pulse, right/left/home switches as windows of rotor positions), what the
 // driver chips measure and flag (StallGuard2/4 from sim::StallGuardModel, open load, short,
 // temperature, undervoltage), an optional holding brake per axis, and the module's I/O (DIO0..3,
-// AIN0/1, supply voltage). One signal table for `--set` and scenario files
+// AIN0/1, supply voltage, the enable signal of the shutdown switch). One signal table for `--set` and scenario files
 // (docs/tmcm-3216-drive.md, "Signals"); per-axis signals are named AXIS<n>_<NAME>.
 //
 // Per tick: before_tick() samples sensors and inputs into board(), the firmware ticks,
@@ -35,7 +35,7 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   static constexpr double kTemperatureWarningCelsius = 120.0;
   static constexpr double kOvertemperatureCelsius = 150.0;
 
-  // DIO0..DIO3, AIN0, AIN1, VSUPPLY, then AXIS0_* .. AXIS2_* (LOAD_TORQUE ... BRAKE).
+  // DIO0..DIO3, AIN0, AIN1, VSUPPLY, ENABLE, then AXIS0_* .. AXIS2_* (LOAD_TORQUE ... BRAKE).
   static std::span<const SignalInfo> signal_table();
 
   // The ideal motors: exact positions; load, obstacle and brake signals are accepted without
@@ -43,6 +43,10 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   Tmcm3216SimBoard();
   // Three physical hybrid steppers of the same description.
   explicit Tmcm3216SimBoard(const StepperMotorDescription& motor, int sub_steps = StepperPlant::kDefaultSubSteps);
+  // A motor per axis (`--motor nema17,ideal,nema23`, sim::resolve_stepper_motors): an empty entry,
+  // or an axis beyond the span, has the ideal motor.
+  explicit Tmcm3216SimBoard(std::span<const std::optional<StepperMotorDescription>> motors,
+                            int sub_steps = StepperPlant::kDefaultSubSteps);
 
   board::Tmcm3216Board& board() { return board_; }
   const board::Tmcm3216Board& board() const { return board_; }
@@ -100,6 +104,7 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   std::array<bool, board::Tmcm3216Io::kDioCount> dio_external_{};  // what the outside drives
   std::array<uint16_t, board::Tmcm3216Io::kAnalogInputCount> analog_raw_{};
   int32_t supply_millivolt_ = kDefaultSupplyMillivolt;
+  bool enable_input_ = true;  // the shutdown switch closed: the drivers may run
   // Output logging.
   std::array<int32_t, board::Tmcm3216Io::kDioCount> logged_dio_{};
   std::array<int32_t, kAxisCount> logged_brake_{};

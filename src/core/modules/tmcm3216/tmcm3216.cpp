@@ -418,6 +418,13 @@ uint8_t Tmcm3216::axis_error_register() const {
 
 void Tmcm3216::run_axes(uint32_t dt_us) {
   general_io_.sample(board_.io);
+  // The shutdown switch (5441) is one input for the module: opening it faults every axis (the
+  // hardware has switched their drivers off already); a fault reset keeps them in FAULT while
+  // it stays open.
+  const uint8_t others = static_cast<uint8_t>(error_register_ | axis_error_register());
+  if (emergencies_.update_shutdown(!board_.io.enable_input, emergency_, others).fault) {
+    for (cia402::AxisDrive& drive : drives_) drive.external_fault();
+  }
   bool brake_control[kAxisCount] = {};
   uint8_t brake_duty[kAxisCount] = {};
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
