@@ -91,6 +91,7 @@ size_t EventLoop::poll_once(uint64_t max_wait_us) {
       // The shared_ptr copy keeps the callback alive even if it unwatches itself.
       const std::shared_ptr<Watcher> watcher = watcher_scratch_[i];
       if (revents == 0 || !watcher->active) continue;
+      if ((revents & POLLIN) != 0) ++input_event_count_;
       watcher->callback(revents);
       ++ran;
     }

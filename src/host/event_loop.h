@@ -52,6 +52,9 @@ class EventLoop {
   // Waits at most `max_wait_us` for a descriptor event or a due timer, then runs the callbacks
   // of what happened, the due timers and the deferred work. Returns how many callbacks ran.
   size_t poll_once(uint64_t max_wait_us);
+  // Descriptor callbacks run so far with input ready (POLLIN): how the host runtime tells that a
+  // client has talked to it (a request, a CAN frame, a connection), whatever the protocol.
+  uint64_t input_event_count() const { return input_event_count_; }
 
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const { return stop_requested_; }
@@ -73,6 +76,7 @@ class EventLoop {
   std::vector<pollfd> poll_scratch_;
   std::vector<std::shared_ptr<Watcher>> watcher_scratch_;
   bool stop_requested_ = false;
+  uint64_t input_event_count_ = 0;
 };
 
 }  // namespace motwin::host

@@ -58,13 +58,18 @@ void HostRuntime::step(uint64_t max_wait_us) {
   // wait_us() is 0 while a whole batch is already due (catching up, or fast mode).
   const uint64_t now_us = monotonic_now_us();
   const uint64_t wait_us = now_us < busy_poll_until_us_ ? 0 : pacer_.wait_us(now_us, sim_time_us());
+  const uint64_t input_events_before = loop_.input_event_count();
   loop_.poll_once(std::min(wait_us, max_wait_us));
   if (service_) service_->serve_queued();
   report_output_changes();
+  // Input on any descriptor (a TMCL request, a CAN frame from a socketcand or SLCAN client, a
+  // connection) means a host is talking; a served TMCL request (also one queued earlier) too.
+  bool host_talked = loop_.input_event_count() != input_events_before;
   if (service_ && service_->served_request_count() != served_requests_seen_) {
     served_requests_seen_ = service_->served_request_count();
-    busy_poll_until_us_ = monotonic_now_us() + kBusyPollAfterRequestUs;
+    host_talked = true;
   }
+  if (host_talked) busy_poll_until_us_ = monotonic_now_us() + kBusyPollAfterRequestUs;
 }
 
 void HostRuntime::run() {

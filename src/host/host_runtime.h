@@ -19,9 +19,11 @@ namespace motwin::host {
 
 class HostRuntime {
  public:
-  // After serving a request the loop polls without sleeping this long: a host in a request/reply
+  // After input from a host (a TMCL request over TCP or a pty, a CAN frame from a socketcand or
+  // SLCAN client, ...) the loop polls without sleeping this long: a host in a request/reply
   // exchange sends its next frame within microseconds, and waking a sleeping process on another
-  // CPU can cost more than the whole exchange (docs/host-runtime.md). An idle server still sleeps.
+  // CPU can cost more than the whole exchange (docs/host-runtime.md, docs/benchmarks.md). An idle
+  // server still sleeps.
   static constexpr uint64_t kBusyPollAfterRequestUs = 200;
 
   using OutputListener = std::function<void(const sim::OutputChange& change)>;
@@ -58,6 +60,8 @@ class HostRuntime {
   // reports output changes.
   void advance_ticks(uint64_t ticks);
   uint64_t sim_time_us() const { return module_.sim_time_us(); }
+  // Wall time (monotonic_now_us()) until which step() polls without sleeping; 0 before any input.
+  uint64_t busy_poll_until_us() const { return busy_poll_until_us_; }
 
  private:
   void report_output_changes();

@@ -1,6 +1,6 @@
 // Several virtual modules on one CAN bus in one process (`motwin serve --node ...`): the group is
 // itself a VirtualModule, so the host runtime paces it like a single module. Its tick is the
-// greatest common divisor of the members' ticks (TMCM-1636 50 µs, TMCM-3216 1 ms: 50 µs) and
+// greatest common divisor of the members' ticks (all 50 µs today; the gcd keeps any mix exact) and
 // each member runs the ticks that bring it up to the group's simulated time, so every member
 // and the bus share one clock. Members speak on the bus only: no TMCL over TCP or a pty, no
 // input signals (docs/canopen.md, "Several modules on one bus").
