@@ -4,8 +4,9 @@
 #   scripts/fuzz.sh TARGET [SECONDS]    one target, default 600 s; its corpus grows in
 #                                       build-fuzz/corpus/TARGET (seeds: fuzz/corpus/TARGET)
 #   scripts/fuzz.sh all [SECONDS]       every target in turn, SECONDS each (default 600)
-#   scripts/fuzz.sh --smoke [SECONDS]   the test command's bounded run: every target SECONDS each
-#                                       (default 6) from the seeds, in a scratch corpus
+#   scripts/fuzz.sh --smoke [SECONDS]   the test command's bounded run: every target from the seeds,
+#                                       in a scratch corpus, sharing SECONDS in total (default 150,
+#                                       start-up included; at least 3 s per target)
 #   scripts/fuzz.sh --list              the targets
 #
 # A crash or a violated invariant stops the run with exit status 1 and leaves the input in
@@ -17,12 +18,16 @@ build=${MOTWIN_FUZZ_BUILD:-build-fuzz}
 jobs=$(nproc 2>/dev/null || echo 2)
 
 usage() {
-  sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 [ $# -ge 1 ] || usage
 mode=$1
 seconds=${2:-}
+if [ -n "$seconds" ] && ! [[ $seconds =~ ^[0-9]+$ ]]; then
+  echo "fuzz: SECONDS must be a whole number, not '$seconds'" >&2
+  exit 2
+fi
 
 if ! command -v clang++ >/dev/null; then
   echo "fuzz: clang++ is not installed (scripts/install-deps.sh installs it)" >&2
@@ -66,11 +71,27 @@ case "$mode" in
     printf '%s\n' "${targets[@]}"
     ;;
   --smoke)
+    # SECONDS is the whole run's budget, so adding a target shortens the others instead of
+    # lengthening the test command. Each target gets an even share of what is left, less the second
+    # or so a libFuzzer process runs beyond -max_total_time (seed replay, final stats, leak check);
+    # sharing what is left also absorbs a target that took longer.
+    budget=${seconds:-150}
+    smoke_share() {  # seconds-left targets-left
+      local share=$(($1 / $2 - 1))
+      echo $((share < 3 ? 3 : share))
+    }
     status=0
     rm -rf "$build/smoke-corpus"
+    left=${#targets[@]}
+    printf 'fuzz smoke: %d s over %d targets, %d s of fuzzing each (at least 3)\n' "$budget" "$left" \
+      "$(smoke_share "$budget" "$left")"
+    smoke_start=$SECONDS
     for target in "${targets[@]}"; do
-      run_target "$target" "${seconds:-6}" "$build/smoke-corpus/$target" || status=1
+      run_target "$target" "$(smoke_share $((budget - (SECONDS - smoke_start))) "$left")" \
+        "$build/smoke-corpus/$target" || status=1
+      left=$((left - 1))
     done
+    printf 'fuzz smoke: %d s\n' $((SECONDS - smoke_start))
     exit $status
     ;;
   all)

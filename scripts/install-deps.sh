@@ -6,7 +6,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libfmt-dev nlohmann-json3-dev
   python3 python3-serial python3-can socat
-  ccache clang tshark
+  ccache clang tshark valgrind
 )
 missing=()
 for p in "${packages[@]}"; do
