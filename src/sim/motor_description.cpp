@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <set>
+#include <span>
 #include <sstream>
+#include <variant>
 
 #include <nlohmann/json.hpp>
 
@@ -157,13 +158,113 @@ struct Reader {
   }
 };
 
-void read_section(Reader& parent, const char* key, const std::function<void(Reader&)>& body) {
+// One plain key of the file format: a member of MotorDescription or of one of its sections, with
+// the range a number must be in. The tables below are what the parser reads and what
+// motor_description_json() writes, in this order, so the two cannot drift apart.
+template <typename Section>
+struct Field {
+  const char* key;
+  std::variant<double Section::*, int Section::*, bool Section::*> member;
+  double min = 0.0;
+  double max = 0.0;
+};
+
+using Hall = MotorDescription::Hall;
+using Abn = MotorDescription::Abn;
+using Absolute = MotorDescription::Absolute;
+using Brake = MotorDescription::Brake;
+using Supply = MotorDescription::Supply;
+
+// Top-level numbers without special rules (type, pole pairs, inductance_h and the magnet
+// strength are read by hand: they depend on each other).
+const Field<MotorDescription> kMotorFields[] = {
+    {"resistance_ohm", &MotorDescription::resistance_ohm, 1e-4, 1000.0},
+    {"inductance_d_h", &MotorDescription::inductance_d_h, 1e-7, 1.0},
+    {"inductance_q_h", &MotorDescription::inductance_q_h, 1e-7, 1.0},
+    {"rotor_inertia_kgm2", &MotorDescription::rotor_inertia_kgm2, 1e-9, 100.0},
+    {"viscous_friction_nm_s", &MotorDescription::viscous_friction_nm_s, 0.0, 100.0},
+    {"coulomb_friction_nm", &MotorDescription::coulomb_friction_nm, 0.0, 1000.0},
+    {"initial_angle_deg", &MotorDescription::initial_angle_deg, -360.0, 360.0},
+};
+const Field<Hall> kHallFields[] = {
+    {"present", &Hall::present},
+    {"offset_deg", &Hall::offset_deg, -360.0, 360.0},
+    {"inverted", &Hall::inverted},
+    {"reversed", &Hall::reversed},
+};
+const Field<Abn> kAbnFields[] = {
+    {"present", &Abn::present},
+    {"counts_per_rev", &Abn::counts_per_rev, 4, 16777215},
+    {"index_deg", &Abn::index_deg, -360.0, 360.0},
+    {"reversed", &Abn::reversed},
+};
+const Field<Absolute> kAbsoluteFields[] = {
+    {"present", &Absolute::present},
+    {"bits", &Absolute::bits, 8, 16},
+    {"offset_deg", &Absolute::offset_deg, -360.0, 360.0},
+    {"reversed", &Absolute::reversed},
+};
+const Field<Brake> kBrakeFields[] = {
+    {"present", &Brake::present},
+    {"holding_torque_nm", &Brake::holding_torque_nm, 0.0, 1000.0},
+    {"pull_in_duty_percent", &Brake::pull_in_duty_percent, 0.0, 100.0},
+    {"drop_out_duty_percent", &Brake::drop_out_duty_percent, 0.0, 100.0},
+    {"time_constant_s", &Brake::time_constant_s, 1e-4, 10.0},
+};
+const Field<Supply> kSupplyFields[] = {
+    {"voltage_v", &Supply::voltage_v, 0.0, 100.0},
+    {"source_resistance_ohm", &Supply::source_resistance_ohm, 1e-3, 100.0},
+    {"capacitance_f", &Supply::capacitance_f, 1e-6, 10.0},
+    {"brake_resistor_ohm", &Supply::brake_resistor_ohm, 0.1, 1e4},
+    {"regenerative", &Supply::regenerative},
+};
+
+template <typename... Ts>
+struct Overloaded : Ts... {
+  using Ts::operator()...;
+};
+template <typename... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;  // clang 14 has no aggregate deduction yet
+
+template <typename Section>
+void read_fields(Reader& reader, Section& out, std::span<const Field<Section>> fields) {
+  for (const Field<Section>& field : fields) {
+    std::visit(Overloaded{
+                   [&](double Section::*member) { reader.number(field.key, out.*member, field.min, field.max); },
+                   [&](int Section::*member) {
+                     reader.integer(field.key, out.*member, static_cast<int>(field.min), static_cast<int>(field.max));
+                   },
+                   [&](bool Section::*member) { reader.flag(field.key, out.*member); },
+               },
+               field.member);
+  }
+}
+
+template <typename Section>
+void write_fields(OrderedJson& j, const Section& section, std::span<const Field<Section>> fields) {
+  for (const Field<Section>& field : fields) {
+    std::visit([&](auto member) { j[field.key] = section.*member; }, field.member);
+  }
+}
+
+// A sub-object ("hall", "brake", ...). A section that has a "present" key counts as present when
+// the file gives it, unless it says "present": false.
+template <typename Section>
+void read_section(Reader& parent, const char* key, Section& out, std::span<const Field<Section>> fields) {
   const Json* section = parent.find(key);
   if (section == nullptr || !parent.ok()) return;
   if (!section->is_object()) return parent.fail(parent.where(key) + " must be an object");
+  if constexpr (requires { out.present; }) out.present = true;
   Reader reader{*section, parent.where(key), parent.error};
-  body(reader);
+  read_fields(reader, out, fields);
   if (reader.ok()) reader.finish();
+}
+
+template <typename Section>
+OrderedJson section_json(const Section& section, std::span<const Field<Section>> fields) {
+  OrderedJson j = OrderedJson::object();
+  write_fields(j, section, fields);
+  return j;
 }
 
 // The axis parameters must exist, be stored in the EEPROM (E) and be in range.
@@ -219,12 +320,10 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
     top.fail("type must be \"bldc\" or \"dc\", got \"" + kind + "\"");
   }
   top.integer("pole_pairs", m.pole_pairs, 1, 255);
-  top.number("resistance_ohm", m.resistance_ohm, 1e-4, 1000.0);
+  // Both inductances at once; inductance_d_h / inductance_q_h (kMotorFields) override it.
   double inductance = -1.0;
   top.number("inductance_h", inductance, 1e-7, 1.0);
   if (inductance > 0.0) m.inductance_d_h = m.inductance_q_h = inductance;
-  top.number("inductance_d_h", m.inductance_d_h, 1e-7, 1.0);
-  top.number("inductance_q_h", m.inductance_q_h, 1e-7, 1.0);
   // The magnet strength, in whichever form the datasheet gives it.
   double flux = -1.0;
   double kt = -1.0;
@@ -245,48 +344,12 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   } else {
     top.fail("give one of flux_linkage_wb, torque_constant_nm_per_a or kv_rpm_per_v");
   }
-  top.number("rotor_inertia_kgm2", m.rotor_inertia_kgm2, 1e-9, 100.0);
-  top.number("viscous_friction_nm_s", m.viscous_friction_nm_s, 0.0, 100.0);
-  top.number("coulomb_friction_nm", m.coulomb_friction_nm, 0.0, 1000.0);
-  top.number("initial_angle_deg", m.initial_angle_deg, -360.0, 360.0);
-  read_section(top, "hall", [&](Reader& r) {
-    m.hall.present = true;
-    r.flag("present", m.hall.present);
-    r.number("offset_deg", m.hall.offset_deg, -360.0, 360.0);
-    r.flag("inverted", m.hall.inverted);
-    r.flag("reversed", m.hall.reversed);
-  });
-  read_section(top, "abn_encoder", [&](Reader& r) {
-    m.abn.present = true;
-    r.flag("present", m.abn.present);
-    int counts = m.abn.counts_per_rev;
-    r.integer("counts_per_rev", counts, 4, 16777215);
-    m.abn.counts_per_rev = counts;
-    r.number("index_deg", m.abn.index_deg, -360.0, 360.0);
-    r.flag("reversed", m.abn.reversed);
-  });
-  read_section(top, "absolute_encoder", [&](Reader& r) {
-    m.absolute.present = true;
-    r.flag("present", m.absolute.present);
-    r.integer("bits", m.absolute.bits, 8, 16);
-    r.number("offset_deg", m.absolute.offset_deg, -360.0, 360.0);
-    r.flag("reversed", m.absolute.reversed);
-  });
-  read_section(top, "brake", [&](Reader& r) {
-    m.brake.present = true;
-    r.flag("present", m.brake.present);
-    r.number("holding_torque_nm", m.brake.holding_torque_nm, 0.0, 1000.0);
-    r.number("pull_in_duty_percent", m.brake.pull_in_duty_percent, 0.0, 100.0);
-    r.number("drop_out_duty_percent", m.brake.drop_out_duty_percent, 0.0, 100.0);
-    r.number("time_constant_s", m.brake.time_constant_s, 1e-4, 10.0);
-  });
-  read_section(top, "supply", [&](Reader& r) {
-    r.number("voltage_v", m.supply.voltage_v, 0.0, 100.0);
-    r.number("source_resistance_ohm", m.supply.source_resistance_ohm, 1e-3, 100.0);
-    r.number("capacitance_f", m.supply.capacitance_f, 1e-6, 10.0);
-    r.number("brake_resistor_ohm", m.supply.brake_resistor_ohm, 0.1, 1e4);
-    r.flag("regenerative", m.supply.regenerative);
-  });
+  read_fields<MotorDescription>(top, m, kMotorFields);
+  read_section<Hall>(top, "hall", m.hall, kHallFields);
+  read_section<Abn>(top, "abn_encoder", m.abn, kAbnFields);
+  read_section<Absolute>(top, "absolute_encoder", m.absolute, kAbsoluteFields);
+  read_section<Brake>(top, "brake", m.brake, kBrakeFields);
+  read_section<Supply>(top, "supply", m.supply, kSupplyFields);
   if (const Json* parameters = top.find("axis_parameters"); parameters != nullptr && top.ok()) {
     if (!parameters->is_object()) {
       top.fail("axis_parameters must be an object of \"number\": value");
@@ -376,29 +439,12 @@ std::string motor_description_json(const MotorDescription& m) {
   } else {
     j["torque_constant_nm_per_a"] = m.torque_constant_nm_per_a;
   }
-  j["resistance_ohm"] = m.resistance_ohm;
-  j["inductance_d_h"] = m.inductance_d_h;
-  j["inductance_q_h"] = m.inductance_q_h;
-  j["rotor_inertia_kgm2"] = m.rotor_inertia_kgm2;
-  j["viscous_friction_nm_s"] = m.viscous_friction_nm_s;
-  j["coulomb_friction_nm"] = m.coulomb_friction_nm;
-  j["initial_angle_deg"] = m.initial_angle_deg;
-  j["hall"] = {{"present", m.hall.present}, {"offset_deg", m.hall.offset_deg}, {"inverted", m.hall.inverted},
-               {"reversed", m.hall.reversed}};
-  j["abn_encoder"] = {{"present", m.abn.present}, {"counts_per_rev", m.abn.counts_per_rev},
-                      {"index_deg", m.abn.index_deg}, {"reversed", m.abn.reversed}};
-  j["absolute_encoder"] = {{"present", m.absolute.present}, {"bits", m.absolute.bits},
-                           {"offset_deg", m.absolute.offset_deg}, {"reversed", m.absolute.reversed}};
-  j["brake"] = {{"present", m.brake.present},
-                {"holding_torque_nm", m.brake.holding_torque_nm},
-                {"pull_in_duty_percent", m.brake.pull_in_duty_percent},
-                {"drop_out_duty_percent", m.brake.drop_out_duty_percent},
-                {"time_constant_s", m.brake.time_constant_s}};
-  j["supply"] = {{"voltage_v", m.supply.voltage_v},
-                 {"source_resistance_ohm", m.supply.source_resistance_ohm},
-                 {"capacitance_f", m.supply.capacitance_f},
-                 {"brake_resistor_ohm", m.supply.brake_resistor_ohm},
-                 {"regenerative", m.supply.regenerative}};
+  write_fields<MotorDescription>(j, m, kMotorFields);
+  j["hall"] = section_json<Hall>(m.hall, kHallFields);
+  j["abn_encoder"] = section_json<Abn>(m.abn, kAbnFields);
+  j["absolute_encoder"] = section_json<Absolute>(m.absolute, kAbsoluteFields);
+  j["brake"] = section_json<Brake>(m.brake, kBrakeFields);
+  j["supply"] = section_json<Supply>(m.supply, kSupplyFields);
   OrderedJson parameters = OrderedJson::object();
   for (const auto& [number, value] : m.startup_parameters) parameters[std::to_string(number)] = value;
   j["axis_parameters"] = parameters;

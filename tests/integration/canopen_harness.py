@@ -1,11 +1,10 @@
 """CAN helpers for the integration tests: `motwin serve --module tmcm-3216 --can socketcand:...`
 and a raw-frame CANopen client on Debian's python3-can (socketcand interface).
 
-Builds on motwin_harness (process handling, watchdog, run_tests); only the serve contract lines
-and the client differ. Raw frames on purpose: what is checked is the wire, not a library's view.
+Builds on motwin_harness (process handling, the serve contract, watchdog, run_tests): CanServer
+only declares its banner and endpoint lines. Raw frames on purpose: what is checked is the wire, not a library's view.
 """
 
-import re
 import socket
 import struct
 import time
@@ -32,43 +31,16 @@ def crc16_ccitt(data, crc=0):
 class CanServer(mh.Server):
     """`motwin serve` running a TMCM-3216 on a socketcand endpoint on a free port."""
 
+    BANNER = r"motwin: tmcm-3216 \(CANopen V1\.04\) eeprom (.+)"
+    PORT_ENDPOINTS = {"can-socketcand": "can_port", "can-slcan-tcp": "slcan_port"}
+
     def __init__(self, motwin, state_dir, node_id=None, speed=None, extra_args=(),
                  can=("socketcand:127.0.0.1:0",)):
-        super().__init__(motwin, state_dir, tcp=False)
-        self.args = [motwin, "serve", "--module", "tmcm-3216", "--state-dir", state_dir]
-        for spec in can:
-            self.args += ["--can", spec]
+        args = [arg for spec in can for arg in ("--can", spec)]
         if node_id is not None:
-            self.args += ["--node-id", str(node_id)]
-        if speed:
-            self.args += ["--speed", speed]
-        self.args += list(extra_args)
-        self.can_port = None
-        self.slcan_port = None
-
-    def _parse_line(self, text):
-        if text == "ready":
-            check(self.banner is not None, f"'ready' before the banner line: {self.stdout_lines!r}")
-            check(self.can_port is not None or self.slcan_port is not None,
-                  f"'ready' without a CAN endpoint: {self.stdout_lines!r}")
-            return True
-        m = re.fullmatch(r"motwin: tmcm-3216 \(CANopen V1\.04\) eeprom (.+)", text)
-        if m:
-            check(self.banner is None, f"two banner lines: {self.stdout_lines!r}")
-            self.banner = text
-            self.eeprom_path = m.group(1)
-            return False
-        m = re.fullmatch(r"endpoint can-socketcand 127\.0\.0\.1:(\d+)", text)
-        if m:
-            self.can_port = int(m.group(1))
-            check(0 < self.can_port < 65536, f"bad port in {text!r}")
-            return False
-        m = re.fullmatch(r"endpoint can-slcan-tcp 127\.0\.0\.1:(\d+)", text)
-        if m:
-            self.slcan_port = int(m.group(1))
-            check(0 < self.slcan_port < 65536, f"bad port in {text!r}")
-            return False
-        raise ServerError(f"unexpected line on serve's stdout: {text!r} (all: {self.stdout_lines!r})")
+            args += ["--node-id", str(node_id)]
+        super().__init__(motwin, state_dir, tcp=False, speed=speed, extra_args=args + list(extra_args),
+                         module="tmcm-3216")
 
     def bus(self):
         return CanopenClient(self.can_port)

@@ -300,12 +300,20 @@ class ServerError(TestFailure):
 
 
 class Server:
-    """One `motwin serve` process. Use as a context manager: the process is killed on exit."""
+    """One `motwin serve` process. Use as a context manager: the process is killed on exit.
 
-    def __init__(self, motwin, state_dir, tcp=True, pty_link=None, speed=None, extra_args=()):
+    The serve contract lines it accepts are declared below; a subclass for another module or other
+    endpoints overrides BANNER and PORT_ENDPOINTS (canopen_harness.CanServer)."""
+
+    # The banner line; its group is the EEPROM image's path.
+    BANNER = r"motwin: tmcm-1636 \(1636V109\) eeprom (.+)"
+    # `endpoint KIND 127.0.0.1:PORT` lines: KIND -> the attribute that keeps the port.
+    PORT_ENDPOINTS = {"tmcl-tcp": "tcp_port"}
+
+    def __init__(self, motwin, state_dir, tcp=True, pty_link=None, speed=None, extra_args=(), module="tmcm-1636"):
         self.motwin = motwin
         self.state_dir = state_dir
-        self.args = [motwin, "serve", "--module", "tmcm-1636", "--state-dir", state_dir]
+        self.args = [motwin, "serve", "--module", module, "--state-dir", state_dir]
         if tcp:
             self.args += ["--tmcl-tcp", "127.0.0.1:0"]
         if pty_link:
@@ -318,6 +326,8 @@ class Server:
         self.banner = None
         self.eeprom_path = None
         self.tcp_port = None
+        for attribute in self.PORT_ENDPOINTS.values():
+            setattr(self, attribute, None)
         self.pty_link = None
         self.pty_device = None
         self._stderr_file = None
@@ -389,18 +399,20 @@ class Server:
         """Returns True on `ready`. Checks each line against the serve contract."""
         if text == "ready":
             check(self.banner is not None, f"'ready' before the banner line: {self.stdout_lines!r}")
-            check(self.tcp_port is not None or self.pty_link is not None, f"'ready' without endpoints: {self.stdout_lines!r}")
+            endpoints = [getattr(self, attribute) for attribute in self.PORT_ENDPOINTS.values()] + [self.pty_link]
+            check(any(e is not None for e in endpoints), f"'ready' without endpoints: {self.stdout_lines!r}")
             return True
-        m = re.fullmatch(r"motwin: tmcm-1636 \(1636V109\) eeprom (.+)", text)
+        m = re.fullmatch(self.BANNER, text)
         if m:
             check(self.banner is None, f"two banner lines: {self.stdout_lines!r}")
             self.banner = text
             self.eeprom_path = m.group(1)
             return False
-        m = re.fullmatch(r"endpoint tmcl-tcp 127\.0\.0\.1:(\d+)", text)
-        if m:
-            self.tcp_port = int(m.group(1))
-            check(0 < self.tcp_port < 65536, f"bad port in {text!r}")
+        m = re.fullmatch(r"endpoint (\S+) 127\.0\.0\.1:(\d+)", text)
+        if m and m.group(1) in self.PORT_ENDPOINTS:
+            port = int(m.group(2))
+            check(0 < port < 65536, f"bad port in {text!r}")
+            setattr(self, self.PORT_ENDPOINTS[m.group(1)], port)
             return False
         m = re.fullmatch(r"endpoint tmcl-pty (\S+) (/dev/pts/\d+)", text)
         if m:

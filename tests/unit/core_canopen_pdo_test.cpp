@@ -379,9 +379,16 @@ void configure_tpdo_like_python_canopen(Tmcm3216Rig& rig, uint16_t comm, uint32_
   ASSERT_EQ(rig.download(comm, 1, cob_id), 0u);
 }
 
-TEST(Tmcm3216Pdo, default_pdos_map_absent_ciA402_objects_and_stay_silent) {
+// The manual's default PDOs (tables 41-47, axis 0's valid): starting the node sends the
+// event-driven TPDO 1 (6041) and TPDO 2 (6041 + 6061) once; then, with no value changing, no
+// event timer and no SYNC (TPDO 3/4), no PDO goes out.
+TEST(Tmcm3216Pdo, default_tpdos_1_and_2_go_out_on_start_then_stay_silent) {
   Tmcm3216Rig rig;
-  rig.nmt(0x01, 0);
+  const auto at_start = rig.send(frame_of(0x000, {0x01, 0}));
+  ASSERT_EQ(only(at_start, 0x181).size(), 1u);
+  ASSERT_EQ(only(at_start, 0x281).size(), 1u);
+  EXPECT_EQ(only(at_start, 0x181)[0].dlc, 2);  // 6041
+  EXPECT_EQ(only(at_start, 0x281)[0].dlc, 3);  // 6041 + 6061
   const auto frames = run_ms(rig, 100);
   for (const can::CanFrame& f : frames) EXPECT_FALSE(f.id >= 0x180 && f.id < 0x580) << std::hex << f.id;
 }
