@@ -38,6 +38,7 @@
 #include "host/module_group.h"
 #include "host/module_registry.h"
 #include "host/pacing.h"
+#include "host/persist_crash_hook.h"
 #include "host/pty_endpoint.h"
 #include "host/slcan_server.h"
 #include "host/socketcand_server.h"
@@ -177,6 +178,8 @@ int run_serve(const ServeArguments& arguments) {
   std::string error;
   const std::optional<host::Pacing> pacing = host::Pacing::parse(arguments.speed, error);
   if (!pacing) throw ServeError{error};
+  // The crash-point test hook, before any image is opened: opening may already write one.
+  if (!host::install_persist_crash_hook_from_environment(error)) throw ServeError{error};
 
   host::ModuleOptions options;
   options.motor = arguments.motor;

@@ -81,6 +81,12 @@ int write_all(int fd, const uint8_t* bytes, size_t length) {
   return 0;
 }
 
+// One per process: the crash hook watches the writes of every module's file.
+PersistStepObserver& process_persist_observer() {
+  static PersistStepObserver observer;
+  return observer;
+}
+
 }  // namespace
 
 void log_to_stderr(const std::string& line) {
@@ -234,6 +240,15 @@ bool EepromFile::write(size_t offset, const uint8_t* bytes, size_t length) {
     return false;
   }
   return true;
+}
+
+void EepromFile::set_process_persist_observer(PersistStepObserver observer) {
+  process_persist_observer() = std::move(observer);
+}
+
+int EepromFile::injected_fault(PersistStep step) const {
+  if (const PersistStepObserver& observer = process_persist_observer()) observer(step);
+  return fault_injector_ ? fault_injector_(step) : 0;
 }
 
 int EepromFile::persist() {

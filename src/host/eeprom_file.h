@@ -46,8 +46,11 @@ enum class EepromLoadOutcome : uint8_t {
   kReplacedDamaged,  // damaged or foreign: reported, kept as <path>.damaged, factory image written
 };
 
-// Steps of an atomic write, for fault injection in tests.
+// Steps of an atomic write, in order, for fault injection in tests.
 enum class PersistStep : uint8_t { kOpenTemporary, kWriteTemporary, kSyncTemporary, kRename, kSyncDirectory };
+
+// Sees each step of every image write of the process just before it runs (host/persist_crash_hook.h).
+using PersistStepObserver = std::function<void(PersistStep)>;
 
 class EepromFile final : public board::NonVolatileMemory {
  public:
@@ -92,6 +95,9 @@ class EepromFile final : public board::NonVolatileMemory {
   // Test hook: called before each step of a write; a non-zero return is taken as that step
   // failing with that errno.
   void set_fault_injector(std::function<int(PersistStep)> injector) { fault_injector_ = std::move(injector); }
+  // Test hook for the whole process (every EepromFile, including the factory image written by
+  // open()): called before each step of a write, before the file's fault injector. nullptr: none.
+  static void set_process_persist_observer(PersistStepObserver observer);
 
   // Encodes a complete file for `payload` (exposed for tests and tools).
   static std::vector<uint8_t> encode(const EepromImageIdentity& identity, const uint8_t* payload);
@@ -102,7 +108,7 @@ class EepromFile final : public board::NonVolatileMemory {
   EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd, LogSink log);
   // Writes image_ to disk atomically; on failure returns the errno.
   int persist();
-  int injected_fault(PersistStep step) const { return fault_injector_ ? fault_injector_(step) : 0; }
+  int injected_fault(PersistStep step) const;
 
   std::filesystem::path path_;
   std::filesystem::path temporary_path_;

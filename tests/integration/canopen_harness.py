@@ -35,12 +35,12 @@ class CanServer(mh.Server):
     PORT_ENDPOINTS = {"can-socketcand": "can_port", "can-slcan-tcp": "slcan_port"}
 
     def __init__(self, motwin, state_dir, node_id=None, speed=None, extra_args=(),
-                 can=("socketcand:127.0.0.1:0",)):
+                 can=("socketcand:127.0.0.1:0",), env=None):
         args = [arg for spec in can for arg in ("--can", spec)]
         if node_id is not None:
             args += ["--node-id", str(node_id)]
         super().__init__(motwin, state_dir, tcp=False, speed=speed, extra_args=args + list(extra_args),
-                         module="tmcm-3216")
+                         module="tmcm-3216", env=env)
 
     def bus(self):
         return CanopenClient(self.can_port)
@@ -272,26 +272,131 @@ class RawSocketcand:
     def send(self, text):
         self.sock.sendall(text.encode("ascii") if isinstance(text, str) else text)
 
+    def _pop_element(self):
+        """The first complete `< ... >` element in the buffer, taken out of it; None if there is none."""
+        start = self.buffer.find(b"<")
+        end = self.buffer.find(b">", start + 1) if start >= 0 else -1
+        if start < 0 or end < 0:
+            return None
+        element = self.buffer[start:end + 1].decode("ascii")
+        self.buffer = self.buffer[end + 1:]
+        return element
+
+    def _receive_more(self, deadline, waiting_for):
+        """Appends what arrives before `deadline` to the buffer; False when the server closed."""
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            raise TestFailure(f"timed out waiting for {waiting_for} (have {self.buffer!r})")
+        self.sock.settimeout(remaining)
+        try:
+            chunk = self.sock.recv(4096)
+        except socket.timeout:
+            return True
+        self.buffer += chunk
+        return bool(chunk)
+
     def read_element(self, timeout=2.0):
         deadline = time.monotonic() + timeout
         while True:
-            start = self.buffer.find(b"<")
-            end = self.buffer.find(b">", start + 1) if start >= 0 else -1
-            if start >= 0 and end >= 0:
-                element = self.buffer[start:end + 1].decode("ascii")
-                self.buffer = self.buffer[end + 1:]
+            element = self._pop_element()
+            if element is not None:
                 return element
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise TestFailure(f"no socketcand element within {timeout} s (have {self.buffer!r})")
-            self.sock.settimeout(remaining)
-            try:
-                chunk = self.sock.recv(4096)
-            except socket.timeout:
-                continue
-            if not chunk:
+            if not self._receive_more(deadline, f"a socketcand element ({timeout} s)"):
                 raise TestFailure("socketcand server closed the connection")
-            self.buffer += chunk
+
+    def elements_until_closed(self, timeout=5.0):
+        """Every element that arrives until the server closes the connection (a crash)."""
+        elements = []
+        deadline = time.monotonic() + timeout
+        while True:
+            element = self._pop_element()
+            if element is not None:
+                elements.append(element)
+                continue
+            try:
+                if not self._receive_more(deadline, f"the server to close the connection (received {elements!r})"):
+                    return elements
+            except ConnectionResetError:
+                return elements
 
     def close(self):
         self.sock.close()
+
+
+def frame_element(cob_id, data):
+    """`< send ... >` for one frame in rawmode."""
+    return "< send %03X %d %s >" % (cob_id, len(data), " ".join(f"{b:02X}" for b in data))
+
+
+def received_frames(elements, cob_id):
+    """The data of the `< frame ... >` elements with that COB-ID."""
+    frames = []
+    for element in elements:
+        parts = element.split()
+        if len(parts) >= 5 and parts[1] == "frame" and int(parts[2], 16) == cob_id:
+            frames.append(bytes.fromhex(parts[4]))
+    return frames
+
+
+class RawSdoClient:
+    """A plain socketcand connection in rawmode with expedited SDO to one node and LSS: no
+    python-can, so that a server killed in the middle of a request is just a closed socket."""
+
+    def __init__(self, port, node):
+        self.node = node
+        self.raw = RawSocketcand(port)
+        check_equal(self.raw.read_element(), "< hi >", "greeting")
+        self.raw.send("< open can0 >")
+        check_equal(self.raw.read_element(), "< ok >", "open")
+        self.raw.send("< rawmode >")
+        check_equal(self.raw.read_element(), "< ok >", "rawmode")
+
+    def send(self, cob_id, data):
+        self.raw.send(frame_element(cob_id, data))
+
+    def receive(self, cob_id):
+        while True:
+            frames = received_frames([self.raw.read_element()], cob_id)
+            if frames:
+                return frames[0]
+
+    def request(self, data):
+        self.send(0x600 + self.node, data)
+        return self.receive(0x580 + self.node)
+
+    @staticmethod
+    def download_request(index, sub, value, size):
+        header = 0x23 | ((4 - size) << 2)
+        return [header, index & 0xFF, index >> 8, sub] + list(value.to_bytes(4, "little"))
+
+    def download(self, index, sub, value, size):
+        """0 on success, else the abort code."""
+        response = self.request(self.download_request(index, sub, value, size))
+        if response[0] == 0x80:
+            return struct.unpack_from("<I", response, 4)[0]
+        check_equal(response[0], 0x60, f"download response for {index:04X}")
+        return 0
+
+    def upload(self, index, sub):
+        response = self.request([0x40, index & 0xFF, index >> 8, sub, 0, 0, 0, 0])
+        check(response[0] & 0xE3 == 0x43, f"expedited upload response {response.hex()}")
+        return struct.unpack_from("<I", response, 4)[0]
+
+    def lss(self, data):
+        """One LSS master frame; the slave's answer."""
+        self.send(0x7E5, list(data) + [0] * (8 - len(data)))
+        return self.receive(0x7E4)
+
+    def lss_configure_node_id(self, node_id):
+        """Switch state global "configuration" (no answer), then configure node ID."""
+        self.send(0x7E5, [0x04, 0x01, 0, 0, 0, 0, 0, 0])
+        check_equal(self.lss([0x11, node_id])[:2], bytes([0x11, 0]), f"LSS configure node ID {node_id}")
+
+    def close(self):
+        self.raw.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()

@@ -69,6 +69,16 @@ class TestFailure(AssertionError):
     pass
 
 
+# The exit status of a script whose every test was skipped: CTest reports it as skipped
+# (SKIP_RETURN_CODE in tests/CMakeLists.txt), not as passed.
+SKIP_STATUS = 77
+
+
+class Skipped(Exception):
+    """Raised by a test that cannot run here (a tool missing, a build it does not apply to):
+    run_tests reports `skip NAME: reason` instead of a failure."""
+
+
 def check(condition, message):
     if not condition:
         raise TestFailure(message)
@@ -310,9 +320,15 @@ class Server:
     # `endpoint KIND 127.0.0.1:PORT` lines: KIND -> the attribute that keeps the port.
     PORT_ENDPOINTS = {"tmcl-tcp": "tcp_port"}
 
-    def __init__(self, motwin, state_dir, tcp=True, pty_link=None, speed=None, extra_args=(), module="tmcm-1636"):
+    def __init__(self, motwin, state_dir, tcp=True, pty_link=None, speed=None, extra_args=(), module="tmcm-1636",
+                 env=None):
         self.motwin = motwin
         self.state_dir = state_dir
+        # Variables added to the test's environment for the server (MOTWIN_CRASH_AT_PERSIST_STEP).
+        # A crash hook left set in the developer's shell would kill every other test's server:
+        # only a test that asks for it gets it.
+        inherited = {k: v for k, v in os.environ.items() if k != "MOTWIN_CRASH_AT_PERSIST_STEP"}
+        self.env = dict(inherited, **(env or {}))
         self.args = [motwin, "serve", "--module", module, "--state-dir", state_dir]
         if tcp:
             self.args += ["--tmcl-tcp", "127.0.0.1:0"]
@@ -338,7 +354,8 @@ class Server:
     def start(self, timeout=STARTUP_TIMEOUT):
         self._open_stderr_file()
         self.proc = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True)
+                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True,
+                                     env=self.env)
         try:
             self._read_until_ready(timeout)
         except BaseException:
@@ -353,7 +370,8 @@ class Server:
         """Starts the server expecting it to exit before `ready`; returns its exit status."""
         self._open_stderr_file()
         self.proc = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True)
+                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True,
+                                     env=self.env)
         try:
             out, _ = self.proc.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -434,14 +452,20 @@ class Server:
         """Sends `sig` and checks the clean exit (status 0)."""
         check(self.alive(), f"server died before stop (status {self.proc.poll()}); stderr {self.stderr_text()!r}")
         self.proc.send_signal(sig)
+        self.wait_for_exit(timeout, overdue=f"did not exit within {timeout} s of signal {sig}")
+        check(self.returncode == 0, f"serve exited with status {self.returncode} after signal {int(sig)}; "
+                                    f"stderr {self.stderr_text()!r}")
+
+    def wait_for_exit(self, timeout=STOP_TIMEOUT, overdue=None):
+        """Waits for the process to end (after stop()'s signal, or by itself: a crash hook) and
+        returns its status (-9: SIGKILL); kills it and fails with `overdue` after `timeout` s."""
         try:
             self.returncode = self.proc.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
             self.kill()
-            raise ServerError(f"serve did not exit within {timeout} s of signal {sig}")
+            raise ServerError(f"serve {overdue or f'still runs {timeout} s after it was expected to end'}")
         self._finish()
-        check(self.returncode == 0, f"serve exited with status {self.returncode} after signal {int(sig)}; "
-                                    f"stderr {self.stderr_text()!r}")
+        return self.returncode
 
     def kill(self):
         """SIGKILL (no check)."""
@@ -511,6 +535,15 @@ class Server:
     def serial(self):
         check(self.pty_link is not None, "server has no pty endpoint")
         return SerialClient(self.pty_link)
+
+
+class Tmcm142Server(Server):
+    """`motwin serve --module tmcm-142` with TMCL over TCP on a free port."""
+
+    BANNER = r"motwin: tmcm-142 \(142V1\.06\) eeprom (.+)"
+
+    def __init__(self, motwin, state_dir, **options):
+        super().__init__(motwin, state_dir, module="tmcm-142", **options)
 
 
 class TempDir:
@@ -619,13 +652,19 @@ def run_tests(tests):
     signal.signal(signal.SIGALRM, on_watchdog)
     signal.alarm(int(args.watchdog))
     failures = 0
+    skipped = 0
+    ran = 0
     script_start = time.monotonic()
     for test in tests:
         if args.only and test.__name__ not in args.only:
             continue
+        ran += 1
         start = time.monotonic()
         try:
             test(motwin)
+        except Skipped as reason:
+            skipped += 1
+            print(f"skip {test.__name__}: {reason}", flush=True)
         except Exception:  # noqa: BLE001 - report every failure, keep going
             failures += 1
             print(f"FAIL {test.__name__} ({time.monotonic() - start:.2f} s)", flush=True)
@@ -634,6 +673,6 @@ def run_tests(tests):
         else:
             print(f"ok   {test.__name__} ({time.monotonic() - start:.2f} s)", flush=True)
     signal.alarm(0)
-    print(f"{'FAILED' if failures else 'passed'}: {failures} failure(s), {time.monotonic() - script_start:.2f} s",
-          flush=True)
-    sys.exit(1 if failures else 0)
+    print(f"{'FAILED' if failures else 'passed'}: {failures} failure(s), "
+          f"{f'{skipped} skipped, ' if skipped else ''}{time.monotonic() - script_start:.2f} s", flush=True)
+    sys.exit(1 if failures else SKIP_STATUS if ran and skipped == ran else 0)
