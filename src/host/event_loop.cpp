@@ -30,6 +30,13 @@ void EventLoop::unwatch(int fd) {
   std::erase_if(watchers_, [fd](const auto& watcher) { return watcher->fd == fd; });
 }
 
+uint64_t EventLoop::quiet_seen_us(int fd) const {
+  for (const auto& watcher : watchers_) {
+    if (watcher->fd == fd) return watcher->quiet_seen_us;
+  }
+  return 0;
+}
+
 bool EventLoop::watching(int fd) const {
   return std::any_of(watchers_.begin(), watchers_.end(), [fd](const auto& watcher) { return watcher->fd == fd; });
 }
@@ -80,16 +87,20 @@ size_t EventLoop::poll_once(uint64_t max_wait_us) {
     poll_scratch_.push_back(pollfd{watcher->fd, watcher->events, 0});
     watcher_scratch_.push_back(watcher);
   }
+  // Input that arrived before this moment is reported by this poll: a descriptor without POLLIN
+  // was quiet then.
+  const uint64_t poll_start_us = monotonic_now_us();
   timespec timeout{};
   timeout.tv_sec = static_cast<time_t>(wait_us / 1'000'000u);
   timeout.tv_nsec = static_cast<long>((wait_us % 1'000'000u) * 1000u);
   const int ready = ::ppoll(poll_scratch_.data(), poll_scratch_.size(), wait_us == kWaitForever ? nullptr : &timeout,
                             nullptr);
-  if (ready > 0) {
+  if (ready >= 0) {
     for (size_t i = 0; i < poll_scratch_.size(); ++i) {
       const short revents = poll_scratch_[i].revents;
       // The shared_ptr copy keeps the callback alive even if it unwatches itself.
       const std::shared_ptr<Watcher> watcher = watcher_scratch_[i];
+      if ((poll_scratch_[i].events & POLLIN) != 0 && (revents & POLLIN) == 0) watcher->quiet_seen_us = poll_start_us;
       if (revents == 0 || !watcher->active) continue;
       if ((revents & POLLIN) != 0) ++input_event_count_;
       watcher->callback(revents);

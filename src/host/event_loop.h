@@ -55,6 +55,12 @@ class EventLoop {
   // Descriptor callbacks run so far with input ready (POLLIN): how the host runtime tells that a
   // client has talked to it (a request, a CAN frame, a connection), whatever the protocol.
   uint64_t input_event_count() const { return input_event_count_; }
+  // When the loop last saw `fd` quiet: the start of the latest poll_once() that watched it for
+  // input (POLLIN) and found none (0: never). Bytes read from it later arrived after that. The
+  // resync gaps of TMCL framing count only this silence, so that a stall of the server itself (a
+  // loaded machine), with the client's bytes waiting in the kernel, is never taken for a pause
+  // of the line.
+  uint64_t quiet_seen_us(int fd) const;
 
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const { return stop_requested_; }
@@ -65,6 +71,7 @@ class EventLoop {
     short events;
     FdCallback callback;
     bool active = true;
+    uint64_t quiet_seen_us = 0;
   };
 
   size_t run_deferred();

@@ -53,6 +53,8 @@ class PtyPort {
 
   const std::string& link_path() const { return link_path_; }
   const std::string& device_path() const { return device_path_; }
+  // When the loop last saw the pty without input (EventLoop::quiet_seen_us).
+  uint64_t quiet_seen_us() const { return loop_.quiet_seen_us(master_fd_); }
   // Queues bytes for the client; false when they were dropped (nobody reads).
   bool write(const uint8_t* bytes, size_t length);
   // Re-reads the read budget and the output state into the poll events.

@@ -19,7 +19,7 @@ TmclPtyEndpoint::TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, cons
   handlers.read_budget = [this] { return service_.input_room(channel_); };
   // Frames or ASCII lines, whichever mode the link is in (the echo comes back through send_reply).
   handlers.on_data = [this](const uint8_t* bytes, size_t length) {
-    service_.receive(channel_, bytes, length, monotonic_now_us());
+    service_.receive(channel_, bytes, length, monotonic_now_us(), port_->quiet_seen_us());
   };
   // The client discarded what it was sending: a partial frame or line goes too.
   handlers.on_flush = [this](bool flushed_output) {

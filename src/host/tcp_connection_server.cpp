@@ -28,6 +28,8 @@ TcpConnection::TcpConnection(TcpConnectionServer& server, uint64_t id, int fd, s
 
 TcpConnection::~TcpConnection() { ::close(fd_); }
 
+uint64_t TcpConnection::quiet_seen_us() const { return server_.loop_.quiet_seen_us(fd_); }
+
 void TcpConnection::on_events(short revents) {
   if ((revents & POLLOUT) != 0) flush();
   if (closing_) return;

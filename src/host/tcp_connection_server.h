@@ -60,6 +60,8 @@ class TcpConnection {
   const std::string& peer() const { return peer_; }
   bool closing() const { return closing_; }
   size_t pending_output() const { return output_.size() - output_sent_; }
+  // When the loop last saw the socket without input (EventLoop::quiet_seen_us).
+  uint64_t quiet_seen_us() const;
   TcpSession& session() { return *session_; }
 
   // Queues bytes and sends what the socket takes now. A client with more than the server's

@@ -119,7 +119,7 @@ class TmclTcpServer::Session final : public TcpSession, public ReplyChannel {
   void on_data(const uint8_t* bytes, size_t length) override {
     // Frames or ASCII lines, whichever mode this connection is in; the echo of ASCII mode may
     // come back through send_reply() (and close us if we cannot take it).
-    service_.receive(channel_, bytes, length, monotonic_now_us());
+    service_.receive(channel_, bytes, length, monotonic_now_us(), connection().quiet_seen_us());
   }
 
   void on_input_closed() override {

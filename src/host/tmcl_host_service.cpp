@@ -61,8 +61,8 @@ std::optional<LinkMode> TmclHostService::link_mode(tmcl::ChannelId id) const {
 }
 
 size_t TmclHostService::queued_requests(tmcl::ChannelId id) const {
-  const auto found = queued_per_channel_.find(id);
-  return found == queued_per_channel_.end() ? 0 : found->second;
+  const auto found = queues_.find(id);
+  return found == queues_.end() ? 0 : found->second.size();
 }
 
 size_t TmclHostService::input_room(tmcl::ChannelId id) const {
@@ -79,10 +79,17 @@ size_t TmclHostService::input_room(tmcl::ChannelId id) const {
   return room;
 }
 
-void TmclHostService::receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us) {
+void TmclHostService::receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us,
+                              std::optional<uint64_t> quiet_seen_us) {
   const auto found = channels_.find(id);
   if (found == channels_.end()) return;
-  for (size_t i = 0; i < length; ++i) found->second.input.push_back(PendingByte{bytes[i], now_us});
+  Channel& channel = found->second;
+  // A byte written 1 ms after the previous one but read 20 ms later, because the server did not
+  // run meanwhile (a loaded machine), followed it without a pause on the line.
+  const uint64_t quiet_until_us = quiet_seen_us.value_or(now_us);
+  if (quiet_until_us > channel.last_receive_us) channel.line_clock_us += quiet_until_us - channel.last_receive_us;
+  channel.last_receive_us = now_us;
+  for (size_t i = 0; i < length; ++i) channel.input.push_back(PendingByte{bytes[i], channel.line_clock_us});
   process_input(id);
 }
 
@@ -94,8 +101,10 @@ void TmclHostService::discard_partial_input(tmcl::ChannelId id) {
 }
 
 void TmclHostService::enqueue(tmcl::ChannelId id, QueuedRequest request) {
-  queue_.push_back(std::move(request));
-  ++queued_per_channel_[id];
+  std::deque<QueuedRequest>& queue = queues_[id];
+  if (queue.empty()) turns_.push_back(id);  // its turn comes after every connection waiting now
+  queue.push_back(std::move(request));
+  ++total_queued_;
 }
 
 void TmclHostService::process_input(tmcl::ChannelId id) {
@@ -135,10 +144,18 @@ void TmclHostService::serve_queued() {
   // A reply callback may end up here again (a channel closing); one loop is enough.
   if (serving_) return;
   serving_ = true;
-  while (!held_ && !queue_.empty()) {
-    const QueuedRequest request = queue_.front();
-    queue_.pop_front();
-    if (--queued_per_channel_[request.channel] == 0) queued_per_channel_.erase(request.channel);
+  while (!held_ && !turns_.empty()) {
+    const tmcl::ChannelId turn = turns_.front();
+    turns_.pop_front();
+    const auto queue = queues_.find(turn);
+    const QueuedRequest request = queue->second.front();
+    queue->second.pop_front();
+    --total_queued_;
+    if (queue->second.empty()) {
+      queues_.erase(queue);
+    } else {
+      turns_.push_back(turn);  // one request per turn
+    }
     Outgoing reply;
     uint8_t delay_ms = 0;
     if (request.ascii) {

@@ -1,7 +1,10 @@
 // Serves TMCL from every host connection (TCP clients, the pseudo-terminal) to one module, the
-// way a module on a serial bus does: one request at a time, in arrival order, each reply to the
-// connection that asked, the telegram pause (GP 75) before a reply without blocking the loop,
-// and the delayed replies of command 138 to the connection that asked.
+// way a module on a serial bus does: one request at a time, each reply to the connection that
+// asked, the telegram pause (GP 75) before a reply without blocking the loop, and the delayed
+// replies of command 138 to the connection that asked. Each connection's requests are served in
+// its order; connections with requests waiting take turns, one request each (round robin), so a
+// client flooding frames delays another client's request by at most one of its own, not by its
+// whole queue (docs/host-runtime.md, "Serving order").
 //
 // Each connection is a link of its own, in binary mode (9-byte frames) or ASCII mode (text
 // lines, core/tmcl/ascii_link.h): command 139 switches it to ASCII once its binary reply is
@@ -71,8 +74,12 @@ class TmclHostService final : public tmcl::ReplySink {
   void close_event_channel(tmcl::ChannelId id);
 
   // Bytes a connection received, in arrival order; at most input_room(id) of them. Complete
-  // frames and lines become requests; the echo of ASCII mode goes out at once.
-  void receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us);
+  // frames and lines become requests; the echo of ASCII mode goes out at once. `now_us`: when
+  // they were read; `quiet_seen_us`: when the loop last saw the connection quiet before them
+  // (EventLoop::quiet_seen_us). Only that silence counts towards the resync gap of binary
+  // framing; without it the whole time since the previous bytes does.
+  void receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us,
+               std::optional<uint64_t> quiet_seen_us = std::nullopt);
   // How many bytes the connection may hand to receive() now; 0: stop reading (back-pressure).
   size_t input_room(tmcl::ChannelId id) const;
   bool has_room(tmcl::ChannelId id) const { return input_room(id) > 0; }
@@ -82,9 +89,9 @@ class TmclHostService final : public tmcl::ReplySink {
   std::optional<LinkMode> link_mode(tmcl::ChannelId id) const;
 
   size_t queued_requests(tmcl::ChannelId id) const;
-  size_t total_queued_requests() const { return queue_.size(); }
+  size_t total_queued_requests() const { return total_queued_; }
 
-  // Serves queued requests in arrival order until the queue is empty or a reply is being held
+  // Serves queued requests, connections in turn, until none is left or a reply is being held
   // for its telegram pause (the next request waits for it, as on a half-duplex bus).
   void serve_queued();
   // Sends the command 138 replies that have become due. Call after each tick batch. Also
@@ -105,7 +112,7 @@ class TmclHostService final : public tmcl::ReplySink {
  private:
   struct PendingByte {
     uint8_t byte;
-    uint64_t arrival_us;  // for the resynchronisation gap of binary framing
+    uint64_t arrival_us;  // on the channel's line clock: for the resynchronisation gap of binary framing
   };
   struct Channel {
     ReplyChannel* sink = nullptr;
@@ -116,6 +123,10 @@ class TmclHostService final : public tmcl::ReplySink {
     // A 139 frame or an ASCII line is queued or being answered: its reply may switch the mode,
     // so the bytes after it wait in `input`.
     bool awaiting_reply = false;
+    // The line clock advances by the silence seen between two receive() calls, not by the
+    // server's own stalls (see receive()).
+    uint64_t line_clock_us = 0;
+    uint64_t last_receive_us = 0;
   };
   struct QueuedRequest {
     tmcl::ChannelId channel;
@@ -154,8 +165,11 @@ class TmclHostService final : public tmcl::ReplySink {
   EventLoop& loop_;
   std::map<tmcl::ChannelId, Channel> channels_;
   std::map<tmcl::ChannelId, tmcl::ReplySink*> event_channels_;
-  std::map<tmcl::ChannelId, size_t> queued_per_channel_;
-  std::deque<QueuedRequest> queue_;
+  // Each connection's waiting requests, and the connections that have some, in the order of
+  // their next turn.
+  std::map<tmcl::ChannelId, std::deque<QueuedRequest>> queues_;
+  std::deque<tmcl::ChannelId> turns_;
+  size_t total_queued_ = 0;
   std::optional<HeldReply> held_;
   tmcl::ChannelId next_channel_id_ = 1;
   uint64_t served_request_count_ = 0;

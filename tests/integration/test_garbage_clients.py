@@ -10,7 +10,14 @@ answers and exits cleanly. More idle connections than the server serves at once 
 existing ones working.
 
 Over the pty: garbage, a pause longer than 5 ms, then a good frame is answered correctly
-(resync by pause); garbage without a pause costs at most one checksum-error reply.
+(resync by pause); garbage without a pause costs at most one checksum-error reply. Frames
+written a byte at a time with pauses shorter than the 5 ms resync gap are answered correctly.
+
+The TMCM-142's ASCII interface over TCP, while a well-behaved binary client loops SGP/GGP/GAP:
+64 KiB of lines for no module (ignored: no reply), bad and overlong lines for this module (one
+reply line each with the documented status), a line typed a byte every 10 ms, clients that
+switch to ASCII and disconnect in the middle of a line (the half line never runs), a client that
+floods lines and never reads (back-pressure or disconnect).
 
 On a TMCM-3216's CAN endpoints (socketcand and SLCAN over TCP), while a well-behaved socketcand
 client loops SDO downloads and uploads and checks every answer (it is the node's only SDO
@@ -20,6 +27,11 @@ served; half elements and half lines followed by a disconnect;
 50 connect/drop (some with a reset); an overlong SLCAN line costs exactly one BEL; a client on
 each endpoint that never reads while another floods the bus with 150 000 frames is disconnected
 (its unread output is bounded) and the others keep working.
+
+TMCL over CAN (a TMCM-1636, request ID 1, reply ID 2) from a socketcand client: frames shorter
+than 7 bytes get the documented status-2 reply, extended ID 1 is answered on extended ID 2,
+other IDs and malformed `send` elements get no reply (an `< error >` for the latter), an SLCAN
+remote frame on ID 1 none either; a good request after each is answered.
 """
 
 import os
@@ -27,40 +39,32 @@ import random
 import socket
 import struct
 import sys
-import threading
 import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from can_bus_harness import BusServer  # noqa: E402
 from canopen_harness import CanServer  # noqa: E402
+from client_harness import (  # noqa: E402
+    ANSWER_1000, UPLOAD_1000, UnitSocket, Worker, is_slcan_frame, run_beside, sdo_1017_round, sdo_answer_data,
+    sdo_answer_of, sdo_element, send_element, slcan_answer, slcan_client, slcan_line, socketcand_client,
+    socketcand_frame,
+)
 from motwin_harness import (  # noqa: E402
-    BANK_USER, GAP, GGP, SAP, SGP, STATUS_OK, Server, TcpClient, TempDir, TestFailure, check, check_equal,
-    expect_reply, frame, parse_reply, run_tests,
+    BANK_USER, GAP, GGP, SAP, SGP, STATUS_OK, Server, TcpClient, TempDir, check, check_equal, expect_reply, frame,
+    parse_reply, run_tests,
 )
 
 CHECKSUM_ERROR_REPLY = bytes.fromhex("02 01 01 00 00 00 00 00 04")
 TCP_RESYNC_PAUSE = 0.25  # longer than the server's TCP resync gap (100 ms, src/host/tcp_server.h)
+SERIAL_RESYNC_GAP = 0.005  # a pause this long between two bytes drops a partial frame (core/tmcl/serial_link.h)
+ENTER_ASCII = 139
 
 
 def random_garbage(rng, length):
     """Random bytes in which no byte is 0x01, so no alignment ever yields a frame for module 1."""
     return bytes(b if b != 1 else 0 for b in (rng.randrange(256) for _ in range(length)))
-
-
-class Worker(threading.Thread):
-    def __init__(self, name, body, port):
-        super().__init__(name=name, daemon=True)
-        self.body = body
-        self.port = port
-        self.failure = None
-        self.note = ""
-
-    def run(self):
-        try:
-            self.note = self.body(self.port) or ""
-        except Exception as error:  # noqa: BLE001 - reported by the main thread
-            self.failure = f"{self.name}: {error!r}"
 
 
 def random_bytes_client(port):
@@ -97,14 +101,20 @@ def slow_client(port):
     return "8 frames byte by byte"
 
 
-def connect_and_drop_clients(port):
-    for i in range(50):
+def connect_and_drop(port, count, first_bytes, every=5):
+    """`count` connections closed at once (every third with a reset); every `every`th sends
+    first_bytes(i) first."""
+    for i in range(count):
         s = socket.create_connection(("127.0.0.1", port), timeout=5.0)
         if i % 3 == 0:
             s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # RST on close
-        if i % 5 == 0:
-            s.sendall(b"\x01")
+        if i % every == 0:
+            s.sendall(first_bytes(i))
         s.close()
+
+
+def connect_and_drop_clients(port):
+    connect_and_drop(port, 50, lambda i: b"\x01")
     return "50 connect/drop"
 
 
@@ -119,13 +129,15 @@ def checksum_error_client(port):
     return "100 checksum errors answered"
 
 
-def never_reading_client(port):
+def never_reading(port, first, chunk):
+    """Sends `first`, then `chunk` over and over without ever reading; the server must push back
+    (stop reading) or disconnect. Returns a note."""
     s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # fill up quickly
     s.settimeout(5.0)
     s.connect(("127.0.0.1", port))
+    s.sendall(first)
     s.setblocking(False)
-    chunk = frame(GAP, 44) * 1000
     sent = 0
     outcome = "sent the limit"
     blocked_since = None
@@ -153,6 +165,10 @@ def never_reading_client(port):
     return f"never read: {sent} bytes sent, {outcome}"
 
 
+def never_reading_client(port):
+    return never_reading(port, b"", frame(GAP, 44) * 1000)
+
+
 WORKERS = [random_bytes_client, half_frame_clients, slow_client, connect_and_drop_clients, checksum_error_client,
            never_reading_client]
 
@@ -174,24 +190,14 @@ def test_tcp_garbage_clients(motwin):
             good = server.tcp()
             try:
                 good.sap(44, 2000)
-                workers = [Worker(w.__name__, w, server.tcp_port) for w in WORKERS]
-                for w in workers:
-                    w.start()
-                rounds = 0
-                slowest = 0.0
-                deadline = time.monotonic() + 60.0
-                while any(w.is_alive() for w in workers) or rounds < 50:
-                    check(time.monotonic() < deadline, "garbage clients still running after 60 s")
-                    slowest = max(slowest, good_client_round(good, rounds))
-                    rounds += 1
-                for w in workers:
-                    w.join(10.0)
-                    check(not w.is_alive(), f"{w.name} did not finish")
-                failures = [w.failure for w in workers if w.failure]
-                check(not failures, f"garbage clients failed: {failures}")
-                for w in workers:
-                    print(f"  {w.name}: {w.note}", flush=True)
-                print(f"  well-behaved client: {rounds} rounds of 5 requests, slowest round {slowest * 1000:.1f} ms",
+                slowest = [0.0]
+
+                def good_round(i):
+                    slowest[0] = max(slowest[0], good_client_round(good, i))
+
+                rounds = run_beside([Worker(w, server.tcp_port) for w in WORKERS], good_round, min_rounds=50,
+                                    timeout=60.0, what="garbage clients")
+                print(f"  well-behaved client: {rounds} rounds of 5 requests, slowest round {slowest[0] * 1000:.1f} ms",
                       flush=True)
                 # The module's state is what the well-behaved client left.
                 good.sap(44, 2000)
@@ -276,152 +282,164 @@ def test_pty_resync_by_pause(motwin):
             server.stop()
 
 
+def send_byte_by_byte(client, data, pause):
+    """Writes `data` one byte at a time with `pause` after each; returns the longest time between
+    two writes as this process saw it (a loaded machine may stall it for longer than asked)."""
+    longest = 0.0
+    last = None
+    for byte in data:
+        now = time.monotonic()
+        if last is not None:
+            longest = max(longest, now - last)
+        last = now
+        client.send_raw(bytes([byte]))
+        time.sleep(pause)
+    return longest
+
+
+def test_pty_slow_writer(motwin):
+    """Frames split into single bytes 1 ms apart (the serial resync gap is 5 ms) are answered
+    correctly. Should this process itself stall for most of the gap between two bytes, the
+    server may rightly drop the partial frame: then the reply is the right one or none at all,
+    and the frame is sent again."""
+    with TempDir() as tmp:
+        link = os.path.join(tmp, "tmcm1636")
+        with Server(motwin, os.path.join(tmp, "state"), tcp=False, pty_link=link) as server:
+            with server.serial() as c:
+                resent = 0
+                longest_gap = 0.0
+                for i in range(8):
+                    value = -70000 - i
+                    write = i % 2 == 0
+                    request = frame(SGP, 202, BANK_USER, value) if write else frame(GGP, 202, BANK_USER)
+                    expected_value = value if write else value + 1
+                    what = f"{'SGP' if write else 'GGP'} 202 byte by byte ({i})"
+                    for attempt in range(20):
+                        gap = send_byte_by_byte(c, request, 0.001)
+                        longest_gap = max(longest_gap, gap)
+                        if gap < SERIAL_RESYNC_GAP * 0.8:
+                            reply = parse_reply(c.read_exact(9, 5.0))
+                            expect_reply(reply, request[1], STATUS_OK, expected_value, what)
+                            break
+                        data = c.read_available(0.1)  # also a pause: what is left of the frame is dropped
+                        if data:
+                            expect_reply(parse_reply(data), request[1], STATUS_OK, expected_value,
+                                         f"{what} after a stall of {gap * 1000:.1f} ms")
+                        resent += 1
+                    else:
+                        raise AssertionError(f"{what}: this process stalled at every attempt")
+                c.expect_no_reply(0.05, "after the slow frames")
+                expect_reply(c.request(GGP, 202, BANK_USER), GGP, STATUS_OK, -70006, "GGP 202 at full speed")
+                print(f"  8 frames byte by byte, longest gap between two writes {longest_gap * 1000:.1f} ms, "
+                      f"{resent} sent again after a stall of this process", flush=True)
+            server.stop()
+
+
+# --- The TMCM-142's ASCII interface over TCP --------------------------------------------------
+
+TMCM142_AP4_DEFAULT = 13743895  # AP 4 at the factory (docs/tmcm-142.md)
+ASCII_NOT_OURS_FIRST = bytes(b for b in range(256) if b not in b"Aa\r\n\b\x7f\t ")
+
+
+def tmcm142_ascii_client(port):
+    """A TCP client switched to ASCII mode (command 139, binary reply first)."""
+    c = TcpClient(port)
+    expect_reply(c.request(ENTER_ASCII), ENTER_ASCII, STATUS_OK, 0, "139 (enter ASCII mode)")
+    return c
+
+
+def ascii_exchange(c, line, expected, what):
+    """Sends `line`; its answer (GP 67 = 32: no echo) must be exactly `expected`, and nothing after it."""
+    c.send_raw(line.encode("latin-1") if isinstance(line, str) else line)
+    check_equal(c.read_exact(len(expected), 10.0).decode("latin-1"), expected, what)
+    stray = c.read_available(0.02)
+    check(stray == b"", f"{what}: unexpected bytes after the answer: {stray!r}")
+
+
+def ascii_garbage_client(port):
+    rng = random.Random(142)
+    lines = []
+    size = 0
+    while size < 65536:  # lines whose first byte is no module's letter: ignored to their end
+        body = bytes(b for b in (rng.randrange(256) for _ in range(rng.randrange(300))) if b not in b"\r\n")
+        lines.append(bytes([rng.choice(ASCII_NOT_OURS_FIRST)]) + body + b"\r")
+        size += len(lines[-1])
+    with tmcm142_ascii_client(port) as c:
+        c.send_raw(b"".join(lines))
+        data = c.read_available(0.5)
+        check(data == b"", f"{len(lines)} lines for no module got an answer: {data[:40]!r}")
+        for line, expected, what in [
+            ("AFOO 1, 2\r", "BA 2 0\r", "unknown word"),
+            ("A\x01\xff\x1b[2J\r", "BA 2 0\r", "control and 8-bit bytes"),
+            ("AGAP 4\r", "BA 4 0\r", "missing operand"),
+            ("AGAP 4,, 0\r", "BA 4 0\r", "empty operand"),
+            ("ASAP 4, 0, 99999999999\r", "BA 4 0\r", "value beyond 32 bits"),
+            ("A" + "X" * 100_000 + "\r", "BA 2 0\r", "a line of 100 000 characters"),
+            ("AGAP 4, 0\r", f"BA 100 {TMCM142_AP4_DEFAULT}\r", "a good line after all that"),
+        ]:
+            ascii_exchange(c, line, expected, what)
+    return f"{size} bytes in {len(lines)} lines for no module (no answer), 6 bad lines answered, then a good one"
+
+
+def ascii_slow_client(port):
+    with tmcm142_ascii_client(port) as c:
+        c.send_raw(b"A")
+        for byte in b"GAP 4, 0":
+            time.sleep(0.01)
+            c.send_raw(bytes([byte]))
+        check_equal(c.read_available(0.05), b"", "answer before the CR")
+        ascii_exchange(c, "\r", f"BA 100 {TMCM142_AP4_DEFAULT}\r", "a line typed a byte every 10 ms")
+    return "a line typed a byte every 10 ms answered"
+
+
+def ascii_half_line_clients(port):
+    enter = frame(ENTER_ASCII)
+    connect_and_drop(port, 20, lambda i: enter + b"ASGP 50, 2, 666"[:4 + i % 12], every=1)  # in one write
+    for i in range(10):
+        with tmcm142_ascii_client(port) as c:
+            c.send_raw(b"ASAP 4, 0, 12"[: 3 + i])
+    return "30 connections left in the middle of an ASCII line"
+
+
+def ascii_never_reading_client(port):
+    return never_reading(port, frame(ENTER_ASCII), b"AGAP 4, 0\r" * 1000)
+
+
+def test_tmcm142_ascii_tcp_misbehaving_clients(motwin):
+    with TempDir() as tmp:
+        args = ["--module", "tmcm-142", "--tmcl-tcp", "127.0.0.1:0"]
+        with BusServer(motwin, os.path.join(tmp, "state"), args) as server:
+            port = server.tcp_port_of()
+            good = TcpClient(port)
+            try:
+                good.sgp(67, 0, 32)  # ASCII replies without echo, so that every byte is predictable
+
+                def good_round(i):
+                    value = 1000 + i
+                    expect_reply(good.request(SGP, 9, BANK_USER, value), SGP, STATUS_OK, value, "good SGP uv 9")
+                    expect_reply(good.request(GGP, 9, BANK_USER), GGP, STATUS_OK, value, "good GGP uv 9")
+                    expect_reply(good.request(GAP, 4), GAP, STATUS_OK, TMCM142_AP4_DEFAULT, "good GAP 4")
+
+                workers = [Worker(w, port) for w in (ascii_garbage_client, ascii_slow_client, ascii_half_line_clients,
+                                                     ascii_never_reading_client)]
+                rounds = run_beside(workers, good_round, min_rounds=30, timeout=60.0, what="ASCII clients")
+                print(f"  well-behaved binary client: {rounds} rounds of 3 requests", flush=True)
+                check_equal(good.ggp(50, BANK_USER), 0, "user variable 50 after the half lines")
+                check_equal(good.gap(4), TMCM142_AP4_DEFAULT, "AP 4 after the half lines")
+            finally:
+                good.close()
+            check(server.alive(), "server died")
+            with TcpClient(port) as c:  # a new connection starts in binary mode (GP 67 bit 0 clear)
+                check_equal(c.version_string(), b"142V1.06", "version afterwards")
+            server.stop()
+
+
 # --- CAN endpoints: socketcand and SLCAN over TCP -----------------------------------------------
 
 CAN_NODE = 5
 FLOOD_FRAMES = 150_000
-
-
-class LineSocket:
-    """A TCP client reading units that end with one of `terminators` (b">" for socketcand
-    elements, CR/BEL for SLCAN answers)."""
-
-    def __init__(self, port, terminators, rcvbuf=None):
-        self.sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        if rcvbuf:
-            self.sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, rcvbuf)
-        self.sock.settimeout(5.0)
-        self.sock.connect(("127.0.0.1", port))
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.terminators = terminators
-        self.buffer = b""
-        self.position = 0  # read up to here
-
-    def send(self, data):
-        self.sock.sendall(data.encode("latin-1") if isinstance(data, str) else data)
-
-    def send_slowly(self, data, pause=0.01):
-        for byte in data.encode("latin-1"):
-            self.sock.sendall(bytes([byte]))
-            time.sleep(pause)
-
-    def read_unit(self, timeout=5.0):
-        deadline = time.monotonic() + timeout
-        while True:
-            ends = [i for i in (self.buffer.find(t, self.position) for t in self.terminators) if i >= 0]
-            if ends:
-                end = min(ends) + 1
-                unit = self.buffer[self.position:end]
-                self.position = end
-                if self.position > 65536:  # drop what was read without copying per unit
-                    self.buffer = self.buffer[self.position:]
-                    self.position = 0
-                return unit.decode("latin-1")
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise TestFailure(f"nothing complete within {timeout} s (have {self.buffer[self.position:][-80:]!r})")
-            self.sock.settimeout(remaining)
-            try:
-                chunk = self.sock.recv(65536)
-            except socket.timeout:
-                continue
-            if not chunk:
-                raise TestFailure("connection closed by the server")
-            self.buffer = self.buffer[self.position:] + chunk
-            self.position = 0
-
-    def read_until(self, predicate, timeout=5.0, what="answer"):
-        deadline = time.monotonic() + timeout
-        while True:
-            unit = self.read_unit(max(0.01, deadline - time.monotonic()))
-            if predicate(unit):
-                return unit
-            if time.monotonic() > deadline:
-                raise TestFailure(f"no {what} within {timeout} s")
-
-    def drain(self, duration):
-        """Discards what arrives within `duration` seconds (the bus keeps talking meanwhile)."""
-        deadline = time.monotonic() + duration
-        try:
-            while time.monotonic() < deadline:
-                self.sock.settimeout(max(0.01, deadline - time.monotonic()))
-                try:
-                    if not self.sock.recv(65536):
-                        break
-                except socket.timeout:
-                    break
-        except OSError:
-            pass
-        self.buffer = b""
-        self.position = 0
-
-    def read_to_eof(self, timeout):
-        """Reads until the server closes the connection; returns the byte count, or None if the
-        connection is still open after `timeout` seconds."""
-        total = 0
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            self.sock.settimeout(max(0.01, deadline - time.monotonic()))
-            try:
-                chunk = self.sock.recv(65536)
-            except socket.timeout:
-                continue
-            except ConnectionResetError:
-                return total
-            if not chunk:
-                return total
-            total += len(chunk)
-        return None
-
-    def close(self):
-        try:
-            self.sock.close()
-        except OSError:
-            pass
-
-
-def socketcand_client(port, rcvbuf=None):
-    c = LineSocket(port, (b">",), rcvbuf)
-    check_equal(c.read_unit().strip(), "< hi >", "socketcand greeting")
-    c.send("< open can0 >")
-    check_equal(c.read_unit().strip(), "< ok >", "open")
-    c.send("< rawmode >")
-    check_equal(c.read_unit().strip(), "< ok >", "rawmode")
-    return c
-
-
-def sdo_element(data):
-    return "< send %03X 8 %s >" % (0x600 + CAN_NODE, " ".join(f"{b:02X}" for b in data))
-
-
-def is_sdo_answer(unit):
-    parts = unit.split()
-    return len(parts) >= 5 and parts[1] == "frame" and int(parts[2], 16) == 0x580 + CAN_NODE
-
-
-def sdo_answer_data(unit):
-    return bytes.fromhex(unit.split()[4])
-
-
-UPLOAD_1000 = [0x40, 0x00, 0x10, 0, 0, 0, 0, 0]
-ANSWER_1000 = bytes.fromhex("430010009201FFFF")
-
-
-def slcan_answer(c):
-    """The next adapter answer (CR, BEL or a reply line), skipping the bus frames an open channel
-    passes on in between."""
-    return c.read_until(lambda u: len(u) == 1 or u[0] not in "tTrR", what="SLCAN answer")
-
-
-def slcan_client(port, rcvbuf=None):
-    c = LineSocket(port, (b"\r", b"\a"), rcvbuf)
-    c.send("O\r")
-    check_equal(c.read_unit(), "\r", "SLCAN open")
-    return c
-
-
-SLCAN_UPLOAD_1000 = "t%03X8%s" % (0x600 + CAN_NODE, bytes(UPLOAD_1000).hex().upper())
-SLCAN_ANSWER_1000 = "t%03X8%s\r" % (0x580 + CAN_NODE, ANSWER_1000.hex().upper())
+SLCAN_UPLOAD_1000 = slcan_line(0x600 + CAN_NODE, UPLOAD_1000)
+SLCAN_ANSWER_1000 = slcan_line(0x580 + CAN_NODE, ANSWER_1000) + "\r"
 
 
 def can_garbage_socketcand(ports):
@@ -456,7 +474,7 @@ def can_garbage_slcan(ports):
 
 
 def can_slowloris(ports):
-    c = LineSocket(ports["socketcand"], (b">",))
+    c = UnitSocket(ports["socketcand"], (b">",))
     try:
         check_equal(c.read_unit().strip(), "< hi >", "greeting")
         c.send_slowly("< open can0 >")
@@ -479,14 +497,8 @@ def can_slowloris(ports):
 
 
 def can_half_and_drop(ports):
-    for i in range(50):
-        port = ports["socketcand"] if i % 2 == 0 else ports["slcan"]
-        s = socket.create_connection(("127.0.0.1", port), timeout=5.0)
-        if i % 3 == 0:
-            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # RST on close
-        if i % 5 == 0:
-            s.sendall(b"< send 605 8 40" if port == ports["socketcand"] else b"t6058400")
-        s.close()
+    connect_and_drop(ports["socketcand"], 25, lambda i: b"< send 605 8 40")
+    connect_and_drop(ports["slcan"], 25, lambda i: b"t6058400")
     return "50 half elements/lines and connect/drop"
 
 
@@ -498,29 +510,10 @@ def test_can_endpoint_garbage_clients(motwin):
             ports = {"socketcand": server.can_port, "slcan": server.slcan_port}
             good = socketcand_client(ports["socketcand"])
             try:
-                workers = [Worker(w.__name__, w, ports) for w in
+                workers = [Worker(w, ports) for w in
                            (can_garbage_socketcand, can_garbage_slcan, can_slowloris, can_half_and_drop)]
-                for w in workers:
-                    w.start()
-                rounds = 0
-                deadline = time.monotonic() + 60.0
-                while any(w.is_alive() for w in workers) or rounds < 30:
-                    check(time.monotonic() < deadline, "CAN garbage clients still running after 60 s")
-                    value = 100 + rounds % 1000
-                    good.send(sdo_element([0x2B, 0x17, 0x10, 0, value & 0xFF, value >> 8, 0, 0]))
-                    check_equal(sdo_answer_data(good.read_until(is_sdo_answer))[:4], bytes([0x60, 0x17, 0x10, 0]),
-                                f"good 1017 = {value}")
-                    good.send(sdo_element([0x40, 0x17, 0x10, 0, 0, 0, 0, 0]))
-                    answer = sdo_answer_data(good.read_until(is_sdo_answer))
-                    check_equal(struct.unpack_from("<H", answer, 4)[0], value, "good 1017 read back")
-                    rounds += 1
-                for w in workers:
-                    w.join(10.0)
-                    check(not w.is_alive(), f"{w.name} did not finish")
-                failures = [w.failure for w in workers if w.failure]
-                check(not failures, f"CAN garbage clients failed: {failures}")
-                for w in workers:
-                    print(f"  {w.name}: {w.note}", flush=True)
+                rounds = run_beside(workers, lambda i: sdo_1017_round(good, CAN_NODE, i), min_rounds=30, timeout=60.0,
+                                    what="CAN garbage clients")
                 print(f"  well-behaved socketcand client: {rounds} rounds of download + upload", flush=True)
             finally:
                 good.close()
@@ -544,8 +537,8 @@ def test_can_never_reading_clients_are_dropped(motwin):
                 for _ in range(FLOOD_FRAMES // 1000):
                     flooder.send(batch)
                 # The flooder never gets its own frames back; it is still served.
-                flooder.send(sdo_element(UPLOAD_1000))
-                check_equal(sdo_answer_data(flooder.read_until(is_sdo_answer, timeout=30.0)), ANSWER_1000,
+                flooder.send(sdo_element(CAN_NODE, UPLOAD_1000))
+                check_equal(sdo_answer_data(flooder.read_until(sdo_answer_of(CAN_NODE), timeout=30.0)), ANSWER_1000,
                             "flooder's SDO upload after the flood")
                 for name, sleepy in (("socketcand", sleepy_socketcand), ("slcan", sleepy_slcan)):
                     received = sleepy.read_to_eof(15.0)
@@ -564,6 +557,90 @@ def test_can_never_reading_clients_are_dropped(motwin):
             server.stop()
 
 
+# --- TMCL over CAN: malformed frames ------------------------------------------------------------
+
+TMCL_RECEIVE_ID, TMCL_SEND_ID = 1, 2
+GGP71 = [GGP, 71, 0, 0, 0, 0, 0]                     # GGP 71 (receive ID), bank 0: value 1
+GGP71_REPLY = bytes([1, STATUS_OK, GGP, 0, 0, 0, 1])  # receive ID, status, command, value
+
+
+def tmcl_can_units(c, element):
+    """Sends `element` and then a good GGP 71 request; returns the error elements, the replies
+    on the send ID (ID, extended, data) up to and including the good request's, in order."""
+    c.send(element)
+    c.send(send_element(TMCL_RECEIVE_ID, GGP71))
+    errors, replies = [], []
+    while True:
+        unit = c.read_unit(10.0)
+        if "error" in unit:
+            errors.append(unit.strip())
+            continue
+        frame_ = socketcand_frame(unit)
+        if frame_ is None or frame_[0] != TMCL_SEND_ID:
+            continue
+        replies.append(frame_)
+        if frame_ == (TMCL_SEND_ID, False, GGP71_REPLY):
+            return errors, replies
+
+
+def status_2(command, length=7, extended=False):
+    """The reply to a frame too short for a request: status 2, its command byte, value 0."""
+    return [(TMCL_SEND_ID, extended, bytes([TMCL_RECEIVE_ID, 2, command]) + bytes(length - 3))]
+
+
+def test_tmcl_over_can_malformed_frames(motwin):
+    good_reply = [(TMCL_SEND_ID, False, GGP71_REPLY)]
+    cases = [  # (what, element, socketcand errors, replies before the good request's)
+        ("empty frame", send_element(1, []), 0, status_2(0)),
+        ("2 bytes", send_element(1, [SGP, 3]), 0, status_2(SGP)),
+        ("6 bytes", send_element(1, [SGP, 3, 2, 0, 0, 7]), 0, status_2(SGP)),
+        ("extended ID 1, 7 bytes", send_element(1, [GGP, 70, 0, 0, 0, 0, 0], extended=True), 0,
+         [(TMCL_SEND_ID, True, bytes([1, STATUS_OK, GGP, 0, 0, 0, 2]))]),
+        ("extended ID 1, 3 bytes", send_element(1, [GGP, 70, 0], extended=True), 0, status_2(GGP, extended=True)),
+        ("8 bytes, a wrong 8th byte (not checked)", send_element(1, [GGP, 70, 0, 0, 0, 0, 0, 0x55]), 0,
+         [(TMCL_SEND_ID, False, bytes([1, STATUS_OK, GGP, 0, 0, 0, 2, 0]))]),
+        ("extended ID 0x10000001", send_element(0x10000001, GGP71, extended=True), 0, []),
+        ("standard ID 0x101", send_element(0x101, GGP71), 0, []),
+        ("ID 0x800 (extended by its value)", send_element(0x800, GGP71), 0, []),
+        ("length 9", "< send 1 9 0A 47 00 00 00 00 00 00 00 >", 1, []),
+        ("length 7, 2 bytes", "< send 1 7 0A 47 >", 1, []),
+        ("bad data byte", "< send 1 7 0A 47 00 00 00 00 XYZ >", 1, []),
+        ("9-digit ID", "< send 100000001 7 0A 47 00 00 00 00 00 >", 1, []),
+        ("no length", "< send 1 >", 1, []),
+        ("unknown command", "< sned 1 7 0A 47 00 00 00 00 00 >", 1, []),
+    ]
+    with TempDir() as tmp:
+        args = ["--module", "tmcm-1636", "--can", "socketcand:127.0.0.1:0", "--can", "slcan-tcp:127.0.0.1:0"]
+        with BusServer(motwin, os.path.join(tmp, "state"), args) as server:
+            c = socketcand_client(server.port())
+            try:
+                for what, element, error_count, replies in cases:
+                    errors, got = tmcl_can_units(c, element)
+                    check_equal(len(errors), error_count, f"{what}: socketcand errors {errors}")
+                    check_equal(got, replies + good_reply, f"{what}: replies on ID 2")
+                # A remote frame on ID 1 over SLCAN: acknowledged by the adapter, not answered by the module.
+                s = slcan_client(server.port("can-slcan-tcp"))
+                try:
+                    for line in ("r0017", "R000000017"):
+                        s.send(line + "\r")
+                        check_equal(slcan_answer(s), "Z\r" if line[0] == "R" else "z\r", f"{line} acknowledged")
+                    s.send(slcan_line(TMCL_RECEIVE_ID, GGP71) + "\r")
+                    check_equal(slcan_answer(s), "z\r", "good request acknowledged")
+                    reply = s.read_until(is_slcan_frame, what="TMCL reply over SLCAN")
+                    check_equal(reply, slcan_line(TMCL_SEND_ID, GGP71_REPLY) + "\r", "first frame after the RTRs")
+                finally:
+                    s.close()
+                c.read_until(lambda u: socketcand_frame(u) == good_reply[0], timeout=10.0,
+                             what="the reply to the SLCAN client's request, seen on socketcand")
+                errors, got = tmcl_can_units(c, "< echo >")
+                check_equal((errors, got), ([], good_reply), "a good request at the end")
+            finally:
+                c.close()
+            check(server.alive(), "server died")
+            server.stop()
+
+
 if __name__ == "__main__":
-    run_tests([test_tcp_garbage_clients, test_many_idle_connections, test_pty_resync_by_pause,
-               test_can_endpoint_garbage_clients, test_can_never_reading_clients_are_dropped])
+    run_tests([test_tcp_garbage_clients, test_many_idle_connections, test_pty_resync_by_pause, test_pty_slow_writer,
+               test_tmcm142_ascii_tcp_misbehaving_clients, test_can_endpoint_garbage_clients,
+               test_can_never_reading_clients_are_dropped, test_tmcl_over_can_malformed_frames])

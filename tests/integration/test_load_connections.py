@@ -13,14 +13,21 @@ harness's 2 s reply timeout, while the load runs.
 - TCP flood: one client pipelines 100 000 GAP frames without waiting and reads the replies as they
   come: exactly 100 000 correct replies, in order.
 - pty flood: 5 000 frames written at once to the pseudo-terminal: 5 000 correct replies.
-- socketcand flood: 100 000 frames on the bus from one client (at most 200 000 per second) while
-  another, reading everything the bus passes on, makes SDO transfers.
+- socketcand flood: 20 000 frames on the bus from one client (100 batches of 200, 10 ms apart:
+  at most 20 000 per second) while another, reading everything the bus passes on, makes SDO
+  transfers.
+- SLCAN over TCP flood: the same 20 000 frames from an SLCAN adapter client, which gets exactly
+  20 000 acknowledgements (`z`), then has an SDO upload answered itself.
+- socketcand connections: 64 clients in raw mode at once (the server's limit), a frame from one
+  reaching the 63 others; a 65th is accepted and closed at once (no greeting) and logged; once
+  one client leaves, a new one is greeted at once; after all have gone the server holds as many
+  descriptors as before.
+
+The SLCAN adapter on a pseudo-terminal is flooded in test_slcan_clients.py.
 """
 
 import os
-import select
 import socket
-import struct
 import sys
 import threading
 import time
@@ -29,61 +36,17 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import CanServer  # noqa: E402
+from client_harness import (  # noqa: E402
+    ANSWER_1000, UPLOAD_1000, Memory, UnitSocket, Worker, check_descriptors_return, open_descriptors,
+    run_beside, sdo_1017_round, sdo_answer_data, sdo_answer_of, sdo_element, send_element, slcan_answer, slcan_client,
+    slcan_line, socketcand_client, socketcand_frame, write_and_read_some,
+)
 from motwin_harness import (  # noqa: E402
     BANK_USER, GAP, GGP, SGP, STATUS_OK, Server, TcpClient, TempDir, check, check_equal, expect_reply, frame,
     parse_reply, run_tests,
 )
-from test_garbage_clients import (  # noqa: E402
-    CAN_NODE, is_sdo_answer, sdo_answer_data, sdo_element, socketcand_client,
-)
 
-MIB = 1024 * 1024
-RSS_GROWTH_LIMIT = 48 * MIB
-RSS_GROWTH_LIMIT_ASAN = 256 * MIB
-
-
-class Memory:
-    """VmRSS of the server, sampled by the test while the load runs."""
-
-    def __init__(self, pid):
-        self.pid = pid
-        with open(f"/proc/{pid}/maps") as f:
-            self.asan = "libasan" in f.read()
-        self.baseline = self.rss()
-        self.peak = self.baseline
-
-    def rss(self):
-        with open(f"/proc/{self.pid}/status") as f:
-            for line in f:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) * 1024
-        raise AssertionError("no VmRSS")
-
-    def sample(self):
-        self.peak = max(self.peak, self.rss())
-        return self.peak
-
-    def check(self, when):
-        self.sample()
-        limit = RSS_GROWTH_LIMIT_ASAN if self.asan else RSS_GROWTH_LIMIT
-        growth = self.peak - self.baseline
-        print(f"  {when}: RSS {self.baseline / MIB:.1f} MiB idle, peak {self.peak / MIB:.1f} MiB "
-              f"(+{growth / MIB:.1f}, limit +{limit / MIB:.0f}{' ASan' if self.asan else ''})", flush=True)
-        check(growth <= limit, f"{when}: RSS grew by {growth / MIB:.1f} MiB (limit {limit / MIB:.0f} MiB)")
-
-
-def open_descriptors(pid):
-    return len(os.listdir(f"/proc/{pid}/fd"))
-
-
-def descriptor_targets(pid):
-    targets = []
-    for fd in sorted(os.listdir(f"/proc/{pid}/fd"), key=int):
-        try:
-            targets.append(f"{fd}:{os.readlink(f'/proc/{pid}/fd/{fd}')}")
-        except OSError:
-            pass
-    return ", ".join(targets)
+CAN_NODE = 5
 
 
 def good_round(c, i):
@@ -93,34 +56,10 @@ def good_round(c, i):
     expect_reply(c.request(GAP, 43), GAP, STATUS_OK, 4000, "good GAP 43")
 
 
-class Load(threading.Thread):
-    def __init__(self, body):
-        super().__init__(daemon=True)
-        self.body = body
-        self.failure = None
-        self.note = ""
-
-    def run(self):
-        try:
-            self.note = self.body() or ""
-        except Exception as error:  # noqa: BLE001 - reported by the main thread
-            self.failure = repr(error)
-
-
 def run_with_good_client(load, good_rounds, memory, min_rounds=20):
-    """Runs `load` in a thread while the main thread runs good_rounds(i); samples the RSS."""
-    worker = Load(load)
-    worker.start()
-    rounds = 0
-    deadline = time.monotonic() + 120.0
-    while worker.is_alive() or rounds < min_rounds:
-        check(time.monotonic() < deadline, "load still running after 120 s")
-        good_rounds(rounds)
-        memory.sample()
-        rounds += 1
-    worker.join()
-    check(worker.failure is None, f"load failed: {worker.failure}")
-    return rounds, worker.note
+    """Runs `load` in a thread while this one runs good_rounds(i), sampling the RSS."""
+    return run_beside([Worker(load)], good_rounds, min_rounds=min_rounds, timeout=120.0, on_round=memory.sample,
+                      what="load")
 
 
 # --- TCP ------------------------------------------------------------------------------------------
@@ -140,8 +79,8 @@ def test_many_tcp_connections(motwin):
                         time.sleep(0.002)  # the listen backlog is 16: no SYN retransmissions
                     return "200 connections open"
 
-                rounds, note = run_with_good_client(open_200, lambda i: good_round(good, i), memory)
-                print(f"  {note}; well-behaved client: {rounds} rounds", flush=True)
+                rounds = run_with_good_client(open_200, lambda i: good_round(good, i), memory)
+                print(f"  well-behaved client: {rounds} rounds", flush=True)
                 for s in held[:20]:  # the first ones are served
                     c = TcpClient.from_socket(s)
                     expect_reply(c.request(GAP, 43), GAP, STATUS_OK, 4000, "GAP on a held connection")
@@ -155,11 +94,7 @@ def test_many_tcp_connections(motwin):
             for i in range(200):
                 with server.tcp() as c:
                     expect_reply(c.request(SGP, 10, BANK_USER, i), SGP, STATUS_OK, i, f"cycle {i}")
-            deadline = time.monotonic() + 10.0
-            while open_descriptors(server.proc.pid) != descriptors_before and time.monotonic() < deadline:
-                time.sleep(0.05)
-            check_equal(open_descriptors(server.proc.pid), descriptors_before,
-                        f"server descriptors after 400 connections ({descriptor_targets(server.proc.pid)})")
+            check_descriptors_return(server.proc.pid, descriptors_before, "after 400 connections")
 
             def client(n, failures):
                 try:
@@ -227,8 +162,8 @@ def test_tcp_frame_flood(motwin):
                     n = pipelined_flood(flood, 100_000, frame(GAP, 43), expected)
                     return f"{n} pipelined GAP frames answered in order"
 
-                rounds, note = run_with_good_client(flood_body, lambda i: good_round(good, i), memory)
-                print(f"  {note}; well-behaved client: {rounds} rounds meanwhile", flush=True)
+                rounds = run_with_good_client(flood_body, lambda i: good_round(good, i), memory)
+                print(f"  well-behaved client: {rounds} rounds meanwhile", flush=True)
             finally:
                 flood.close()
                 good.close()
@@ -259,14 +194,8 @@ def test_pty_frame_flood(motwin):
                         os.set_blocking(fd, False)
                         try:
                             while len(data) < 9 * count and time.monotonic() < deadline:
-                                readable, writable, _ = select.select([fd], [fd] if pending else [], [], 1.0)
-                                if readable:
-                                    data += os.read(fd, 65536)
-                                if writable and pending:
-                                    try:
-                                        pending = pending[os.write(fd, pending[:4096]):]
-                                    except BlockingIOError:
-                                        pass
+                                pending, received = write_and_read_some(fd, pending)
+                                data += received
                         finally:
                             os.set_blocking(fd, True)
                         check(len(data) == 9 * count, f"pty flood: {len(data)} of {9 * count} reply bytes in 120 s")
@@ -276,8 +205,8 @@ def test_pty_frame_flood(motwin):
                         c.expect_no_reply(0.2, "after the pty flood")
                         return f"{count} frames written in 4 KiB pieces, {len(replies)} replies"
 
-                    rounds, note = run_with_good_client(pty_flood, lambda i: good_round(good, i), memory)
-                    print(f"  {note}; well-behaved TCP client: {rounds} rounds meanwhile", flush=True)
+                    rounds = run_with_good_client(pty_flood, lambda i: good_round(good, i), memory)
+                    print(f"  well-behaved TCP client: {rounds} rounds meanwhile", flush=True)
                     expect_reply(c.request(GAP, 43), GAP, STATUS_OK, 4000, "pty GAP after the flood")
             finally:
                 good.close()
@@ -285,44 +214,121 @@ def test_pty_frame_flood(motwin):
             server.stop()
 
 
-# --- socketcand ---------------------------------------------------------------------------------
+# --- CAN endpoints ------------------------------------------------------------------------------
+
+FLOOD_ELEMENT = "< send 123 8 01 02 03 04 05 06 07 08 >"
+FLOOD_BATCHES, FLOOD_BATCH = 100, 200
+
+
+def can_flood_beside_sdo_client(server, flooder, batch, memory):
+    """Sends FLOOD_BATCHES x `batch` (FLOOD_BATCH frames) from `flooder`, 10 ms apart, while a
+    socketcand client on the same server makes SDO rounds and reads everything the bus passes on."""
+    good = socketcand_client(server.can_port)
+    try:
+        def flood():
+            # 20 000 frames per second at most: more than twice what a 1 Mbit/s bus carries.
+            # Every client receives the flood too; a client that cannot keep up is cut off at
+            # the server's output limit (by design), so the rate stays within what a Python
+            # reader on a loaded CI machine drains.
+            for _ in range(FLOOD_BATCHES):
+                flooder.send(batch)
+                time.sleep(0.01)
+            return f"{FLOOD_BATCHES * FLOOD_BATCH} frames sent"
+
+        rounds = run_with_good_client(flood, lambda i: sdo_1017_round(good, CAN_NODE, i), memory)
+        print(f"  well-behaved SDO client: {rounds} rounds meanwhile", flush=True)
+    finally:
+        good.close()
+
 
 def test_socketcand_frame_flood(motwin):
     with TempDir() as tmp:
         server = CanServer(motwin, os.path.join(tmp, "state"), node_id=CAN_NODE)
         with server:
             memory = Memory(server.proc.pid)
-            good = socketcand_client(server.can_port)
             flooder = socketcand_client(server.can_port)
             try:
-                def flood():
-                    # 20 000 frames per second at most: more than twice what a 1 Mbit/s bus carries.
-                    # Every client receives the flood too; a client that cannot keep up is cut off at
-                    # the server's output limit (by design), so the rate stays within what a Python
-                    # reader on a loaded CI machine drains.
-                    batch = b"< send 123 8 01 02 03 04 05 06 07 08 >" * 200
-                    for _ in range(100):
-                        flooder.send(batch)
-                        time.sleep(0.01)
-                    return "20 000 frames sent"
-
-                def sdo_round(i):
-                    value = 100 + i % 1000
-                    good.send(sdo_element([0x2B, 0x17, 0x10, 0, value & 0xFF, value >> 8, 0, 0]))
-                    check_equal(sdo_answer_data(good.read_until(is_sdo_answer, timeout=10.0))[:4],
-                                bytes([0x60, 0x17, 0x10, 0]), f"1017 = {value}")
-                    good.send(sdo_element([0x40, 0x17, 0x10, 0, 0, 0, 0, 0]))
-                    answer = sdo_answer_data(good.read_until(is_sdo_answer, timeout=10.0))
-                    check_equal(struct.unpack_from("<H", answer, 4)[0], value, "1017 read back")
-
-                rounds, note = run_with_good_client(flood, sdo_round, memory)
-                print(f"  {note}; well-behaved SDO client: {rounds} rounds meanwhile", flush=True)
+                can_flood_beside_sdo_client(server, flooder, FLOOD_ELEMENT * FLOOD_BATCH, memory)
+                # The flooder never gets its own frames back; it is still served.
+                flooder.send(sdo_element(CAN_NODE, UPLOAD_1000))
+                check_equal(sdo_answer_data(flooder.read_until(sdo_answer_of(CAN_NODE, 0x1000), timeout=10.0)),
+                            ANSWER_1000, "flooder's SDO upload after the flood")
             finally:
-                good.close()
                 flooder.close()
             memory.check("socketcand flood")
             server.stop()
 
 
+def test_slcan_tcp_frame_flood(motwin):
+    with TempDir() as tmp:
+        server = CanServer(motwin, os.path.join(tmp, "state"), node_id=CAN_NODE,
+                           can=("socketcand:127.0.0.1:0", "slcan-tcp:127.0.0.1:0"))
+        with server:
+            memory = Memory(server.proc.pid)
+            flooder = slcan_client(server.slcan_port)
+            try:
+                batch = (slcan_line(0x123, bytes(range(1, 9))) + "\r") * FLOOD_BATCH
+                can_flood_beside_sdo_client(server, flooder, batch, memory)
+                # Read only now: every frame was acknowledged, in between the bus's frames (the
+                # SDO rounds, the heartbeats they set).
+                acks = 0
+                while acks < FLOOD_BATCHES * FLOOD_BATCH:
+                    answer = slcan_answer(flooder)
+                    check_equal(answer, "z\r", f"SLCAN answer after {acks} acknowledgements")
+                    acks += 1
+                flooder.send(slcan_line(0x600 + CAN_NODE, UPLOAD_1000) + "\r")
+                check_equal(slcan_answer(flooder), "z\r", "the flooder's SDO upload acknowledged")
+                flooder.read_until(lambda u: u == slcan_line(0x580 + CAN_NODE, ANSWER_1000) + "\r", timeout=10.0,
+                                   what="the flooder's SDO answer")
+                print(f"  SLCAN flooder: {acks} acknowledgements, then its SDO upload answered", flush=True)
+            finally:
+                flooder.close()
+            memory.check("SLCAN over TCP flood")
+            server.stop()
+
+
+SOCKETCAND_MAX_CLIENTS = 64  # SocketcandServer::kMaxClients
+
+
+def test_socketcand_many_connections(motwin):
+    with TempDir() as tmp:
+        server = CanServer(motwin, os.path.join(tmp, "state"), node_id=CAN_NODE)
+        with server:
+            pid = server.proc.pid
+            memory = Memory(pid)
+            descriptors_before = open_descriptors(pid)
+            clients = []
+            try:
+                for _ in range(SOCKETCAND_MAX_CLIENTS):
+                    clients.append(socketcand_client(server.can_port))
+                    time.sleep(0.002)  # the listen backlog is 16: no SYN retransmissions
+                # One more is accepted and closed at once, without a greeting.
+                extra = UnitSocket(server.can_port, (b">",))
+                try:
+                    check_equal(extra.read_to_eof(10.0), 0, "bytes the 65th socketcand client got before the close")
+                finally:
+                    extra.close()
+                refused = [line for line in server.stderr_lines() if "refusing socketcand client" in line]
+                check_equal(len(refused), 1, "log lines about a refused client")
+                # Every client is served: a frame from the first reaches all the others.
+                clients[0].send(send_element(0x123, [0xAA, 0x55]))
+                for n, c in enumerate(clients[1:], start=1):
+                    c.read_until(lambda u: socketcand_frame(u) == (0x123, False, b"\xAA\x55"), timeout=10.0,
+                                 what=f"the first client's frame at client {n}")
+                sdo_1017_round(clients[-1], CAN_NODE, 1)
+                # A freed slot is taken at once.
+                clients.pop(0).close()
+                clients.append(socketcand_client(server.can_port))
+                sdo_1017_round(clients[-1], CAN_NODE, 2)
+                print(f"  {SOCKETCAND_MAX_CLIENTS} clients served, the next refused: {refused[0]}", flush=True)
+            finally:
+                for c in clients:
+                    c.close()
+            check_descriptors_return(pid, descriptors_before, "after 66 socketcand connections")
+            memory.check("socketcand connections")
+            server.stop()
+
+
 if __name__ == "__main__":
-    run_tests([test_many_tcp_connections, test_tcp_frame_flood, test_pty_frame_flood, test_socketcand_frame_flood])
+    run_tests([test_many_tcp_connections, test_tcp_frame_flood, test_pty_frame_flood, test_socketcand_frame_flood,
+               test_slcan_tcp_frame_flood, test_socketcand_many_connections])

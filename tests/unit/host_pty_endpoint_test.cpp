@@ -108,6 +108,19 @@ TEST_F(PtyEndpointTest, a_pause_resynchronises_after_a_half_frame) {
   EXPECT_EQ(exchange(client, request(kGap, 43, 0, 0)), reply(100, kGap, 4000));
 }
 
+TEST_F(PtyEndpointTest, a_stall_of_the_server_is_no_pause_of_the_line) {
+  open_endpoint();
+  SerialTestClient client(link());
+  const Bytes frame = request(kGap, 43, 0, 0);
+  client.send(slice(frame, 0, 4));
+  for (int i = 0; i < 20; ++i) rig_.step();  // the first half is read
+  // The rest follows at once, but the server does not run for 20 ms (a loaded machine): the
+  // bytes wait in the pty, and the line itself never paused.
+  client.send(slice(frame, 4, 9));
+  ::usleep(20'000);
+  EXPECT_EQ(exchange(client, {}), reply(100, kGap, 4000));
+}
+
 TEST_F(PtyEndpointTest, a_client_that_flushes_on_open_never_gets_an_old_clients_replies) {
   open_endpoint();
   {

@@ -116,6 +116,18 @@ TEST_F(TcpServerTest, a_half_frame_from_one_client_does_not_disturb_another) {
   EXPECT_EQ(slow.receive_available(), Bytes{});
 }
 
+TEST_F(TcpServerTest, a_stall_of_the_server_is_no_pause_of_the_line) {
+  TcpTestClient client(server_->local_port());
+  const Bytes frame = request(kGap, 43, 0, 0);
+  client.send(slice(frame, 0, 4));
+  settle();  // the first half is read
+  // The rest follows at once, but the server does not run for 150 ms (a loaded machine; the TCP
+  // resync gap is 100 ms): the bytes wait in the kernel, the client never paused.
+  client.send(slice(frame, 4, 9));
+  ::usleep(150'000);
+  EXPECT_EQ(receive(client, 9), reply(100, kGap, kDefaultMaxVelocity));
+}
+
 TEST_F(TcpServerTest, garbage_from_one_client_is_answered_to_it_alone) {
   TcpTestClient noisy(server_->local_port());
   TcpTestClient good(server_->local_port());
