@@ -1,7 +1,9 @@
 // The EEPROM image loader of `motwin serve` (src/host/eeprom_file.*): any bytes in
-// <state-dir>/tmcm-1636.eeprom at start-up.
+// <state-dir>/<module>.eeprom at start-up.
 //
-// Invariants:
+// Input: byte 0 picks the module (mod 3: TMCM-1636, TMCM-142, TMCM-3216: each with its name,
+// layout version, image size and factory image, host::eeprom_identity_of as `motwin serve` uses
+// it); the rest is the file. Invariants:
 // - bytes that validate are loaded as they are: the file is not rewritten, the module's image is
 //   the payload, and encoding that payload again gives the same bytes;
 // - anything else is reported by exactly one log line containing "damaged", the bytes are kept
@@ -19,8 +21,12 @@
 #include <string>
 #include <vector>
 
+#include "core/modules/tmcm142/tmcm142.h"
+#include "core/modules/tmcm1636/tmcm1636.h"
+#include "core/modules/tmcm3216/tmcm3216.h"
 #include "fuzz_support.h"
 #include "host/eeprom_file.h"
+#include "host/module_eeprom.h"
 
 namespace {
 
@@ -40,13 +46,10 @@ fs::path scratch_directory() {
   return directory;
 }
 
-}  // namespace
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  if (size > 64 * 1024) return 0;
-  const host::EepromImageIdentity identity{std::string(fuzz::Tmcm1636::kName), fuzz::Tmcm1636::kNvmLayoutVersion,
-                                           fuzz::Tmcm1636::kNvmLayout.total_size};
-  const std::vector<uint8_t> bytes(data, data + size);
+// One input against one module's image file.
+template <typename Device>
+void load(const std::vector<uint8_t>& bytes) {
+  const host::EepromImageIdentity identity = host::eeprom_identity_of<Device>();
   const fs::path state_dir = scratch_directory();
   std::error_code ignored;
   fs::remove_all(state_dir, ignored);
@@ -54,14 +57,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const fs::path image = host::EepromFile::image_path(state_dir, identity.module_name);
   {
     std::ofstream file(image, std::ios::binary);
-    file.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
 
   const std::string problem = host::EepromFile::validate(identity, bytes);
   std::vector<std::string> log;
-  auto opened = host::EepromFile::open(state_dir, identity, &fuzz::Tmcm1636::format_factory_image,
+  auto opened = host::EepromFile::open(state_dir, identity, &Device::format_factory_image,
                                        [&log](const std::string& line) { log.push_back(line); });
-  FUZZ_CHECK(opened.file != nullptr, "open failed: %s", opened.error.c_str());
+  FUZZ_CHECK(opened.file != nullptr, "%s: open failed: %s", identity.module_name.c_str(), opened.error.c_str());
   const host::EepromFile& file = *opened.file;
   if (problem.empty()) {
     FUZZ_CHECK(file.load_outcome() == host::EepromLoadOutcome::kLoaded, "a valid image was not loaded");
@@ -77,10 +80,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::vector<uint8_t> replaced = read_all(image);
     FUZZ_CHECK(host::EepromFile::validate(identity, replaced).empty(), "the replacement image is not valid");
     std::vector<uint8_t> factory(identity.payload_size);
-    fuzz::Tmcm1636::format_factory_image(factory.data(), factory.size());
+    Device::format_factory_image(factory.data(), factory.size());
     FUZZ_CHECK(host::EepromFile::encode(identity, factory.data()) == replaced, "the replacement is not the factory image");
   }
   opened.file.reset();
   fs::remove_all(state_dir, ignored);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < 1 || size > 64 * 1024) return 0;
+  const std::vector<uint8_t> bytes(data + 1, data + size);
+  switch (data[0] % 3) {
+    case 0: load<modules::tmcm1636::Tmcm1636>(bytes); break;
+    case 1: load<modules::tmcm142::Tmcm142>(bytes); break;
+    default: load<modules::tmcm3216::Tmcm3216>(bytes); break;
+  }
   return 0;
 }

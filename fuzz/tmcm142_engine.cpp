@@ -16,42 +16,15 @@
 #include <cstdint>
 #include <memory>
 
-#include "board/ram_non_volatile_memory.h"
-#include "core/modules/tmcm142/tmcm142.h"
 #include "fuzz_support.h"
-#include "sim/tmcm142_sim_board.h"
-#include "sim/tmcm142_sim_io.h"
 #include "tmcl_instructions.h"
+#include "tmcm142_rig.h"
 
 namespace {
 
 using namespace motwin;
-using Tmcm142 = modules::tmcm142::Tmcm142;
-using Tmcm142Nvm = board::RamNonVolatileMemory<Tmcm142::kNvmLayout.total_size>;
-
-struct Rig {
-  sim::Tmcm142SimIo io;
-  sim::Tmcm142SimBoard board{io};
-  Tmcm142Nvm nvm;
-  std::unique_ptr<Tmcm142> module;
-
-  Rig() {
-    Tmcm142::format_factory_image(nvm.mutable_data(), nvm.size());
-    // Switches a reference search can find: left below, right above, a home cam between.
-    board.set_input("REF_L_AT", -0.5);
-    board.set_input("REF_R_AT", 0.5);
-    board.set_input("REF_H_FROM", 0.1);
-    board.set_input("REF_H_TO", 0.2);
-    board.before_tick();
-    module = std::make_unique<Tmcm142>(nvm, board.power_stage(), io);
-    module->engine().power_up();
-  }
-  void tick() {
-    board.before_tick();
-    module->tick();
-    board.after_tick(modules::tmcm142::kControlTickS);
-  }
-};
+using fuzz::Tmcm142;
+using Rig = fuzz::Tmcm142Rig;
 
 void check_motor(Rig& rig) {
   const double position = rig.board.rotor_revolutions();
@@ -66,7 +39,7 @@ void check_motor(Rig& rig) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   auto rig = std::make_unique<Rig>();
-  tmcl::TmclEngine& engine = rig->module->engine();
+  tmcl::TmclEngine& engine = rig->engine();
   int ticks_left = 20'000;  // 1 s of motion per input at most
   for (int step = 0; step < 256 && in.remaining_bytes() > 0; ++step) {
     if (in.ConsumeIntegralInRange<int>(0, 5) == 0) {

@@ -1,23 +1,23 @@
 #include "host/socketcand_server.h"
 
-#include <vector>
+#include <string>
+#include <string_view>
 
-#include "host/socketcand_protocol.h"
+#include "host/socketcand_session.h"
 #include "host/tcp_connection_server.h"
 
 namespace motwin::host {
 
-// One client: a bus endpoint from the moment it is connected, seeing frames in raw mode.
-class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint {
+// One client: a bus endpoint from the moment it is connected, seeing frames in raw mode. The
+// protocol is SocketcandSession's; this class ties it to the connection and the bus.
+class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint, private SocketcandSession::Io {
  public:
-  enum class Mode : uint8_t { kAwaitOpen, kBcm, kRaw };
-
   Session(CanBus& bus, std::weak_ptr<bool> server_alive, TcpConnectionServer& server)
       : bus_(bus), server_alive_(std::move(server_alive)), server_(server) {}
 
   void on_open() override {
     bus_id_ = bus_.attach(*this);
-    connection().write("< hi >");
+    session_.start();
   }
 
   void on_close() override {
@@ -26,64 +26,22 @@ class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint
   }
 
   void on_data(const uint8_t* bytes, size_t length) override {
-    elements_.clear();
-    parser_.push(std::string_view(reinterpret_cast<const char*>(bytes), length), elements_);
-    for (const std::string& element : elements_) {
-      if (connection().closing()) return;
-      handle(element);
-    }
+    session_.push(std::string_view(reinterpret_cast<const char*>(bytes), length));
   }
 
   // CanBusEndpoint.
   void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override {
-    if (connection().closing() || mode_ != Mode::kRaw) return;
-    connection().write(format_socketcand_frame(frame, timestamp_us));
+    session_.frame_from_bus(frame, timestamp_us);
   }
 
  private:
-  void handle(const std::string& element) {
-    const std::vector<std::string_view> words = socketcand_words(element);
-    const std::string_view command = words.empty() ? std::string_view{} : words[0];
-    switch (mode_) {
-      case Mode::kAwaitOpen:
-        if (command == "open" && words.size() == 2) {
-          mode_ = Mode::kBcm;
-          connection().write("< ok >");
-        } else {
-          error("expected open");
-        }
-        return;
-      case Mode::kBcm:
-      case Mode::kRaw:
-        if (command == "send") {
-          std::string problem;
-          const std::optional<can::CanFrame> frame = parse_socketcand_send(words, problem);
-          if (!frame) {
-            error(problem);
-            return;
-          }
-          bus_.send(bus_id_, *frame);
-        } else if (command == "rawmode" && words.size() == 1) {
-          const bool entering = mode_ != Mode::kRaw;
-          mode_ = Mode::kRaw;
-          connection().write("< ok >");
-          if (entering) hold_output();
-        } else if (command == "bcmmode" && words.size() == 1) {
-          mode_ = Mode::kBcm;
-          connection().write(" < ok >");
-        } else if (command == "echo" && words.size() == 1) {
-          connection().write(" < echo >");
-        } else {
-          error("unknown command");
-        }
-        return;
-    }
-  }
-
-  void error(const std::string& text) { connection().write(" < error " + text + " >"); }
+  // SocketcandSession::Io.
+  void write(const std::string& element) override { connection().write(element); }
+  void send_to_bus(const can::CanFrame& frame) override { bus_.send(bus_id_, frame); }
+  bool closing() const override { return connection().closing(); }
 
   // python-can compares the `< ok >` of rawmode with one recv(): nothing may follow it closely.
-  void hold_output() {
+  void raw_mode_entered() override {
     connection().hold_output(true);
     std::weak_ptr<bool> alive = server_alive_;
     TcpConnectionServer* server = &server_;
@@ -98,9 +56,7 @@ class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint
   std::weak_ptr<bool> server_alive_;
   TcpConnectionServer& server_;
   CanBus::EndpointId bus_id_ = 0;
-  Mode mode_ = Mode::kAwaitOpen;
-  SocketcandElementParser parser_;
-  std::vector<std::string> elements_;
+  SocketcandSession session_{*this};
 };
 
 SocketcandServer::OpenResult SocketcandServer::open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,

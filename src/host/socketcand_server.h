@@ -3,7 +3,8 @@
 // CAN (notes/canopen.md). Every client is a bus endpoint: it sees every frame of the bus except
 // its own, from the moment it is in raw mode.
 //
-// Session, exactly as python-can 4.1.0 expects it (each server element in its own write):
+// Session, exactly as python-can 4.1.0 expects it (each server element in its own write; the
+// protocol logic is host/socketcand_session.h, without sockets):
 //   server `< hi >`; client `< open CHANNEL >`, server `< ok >`; client `< rawmode >`, server
 //   `< ok >`; then client `< send ID LEN B0 .. >` and server ` < frame ID SEC.USEC HEX >`
 //   (a space before each frame: socketcand_protocol.h).

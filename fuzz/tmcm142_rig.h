@@ -1,0 +1,44 @@
+// A TMCM-142 on its simulated board (ideal motor; left and right limit switches and a home cam
+// placed where a reference search finds them) on a RAM EEPROM with the factory image, powered up:
+// shared by the targets that drive its TMCL engine (tmcm142_engine, tmcl_ascii). Needs motwin_sim.
+#pragma once
+
+#include <memory>
+
+#include "board/ram_non_volatile_memory.h"
+#include "core/modules/tmcm142/tmcm142.h"
+#include "core/tmcl/engine.h"
+#include "sim/tmcm142_sim_board.h"
+#include "sim/tmcm142_sim_io.h"
+
+namespace motwin::fuzz {
+
+using Tmcm142 = modules::tmcm142::Tmcm142;
+using Tmcm142Nvm = board::RamNonVolatileMemory<Tmcm142::kNvmLayout.total_size>;
+
+struct Tmcm142Rig {
+  sim::Tmcm142SimIo io;
+  sim::Tmcm142SimBoard board{io};
+  Tmcm142Nvm nvm;
+  std::unique_ptr<Tmcm142> module;
+
+  Tmcm142Rig() {
+    Tmcm142::format_factory_image(nvm.mutable_data(), nvm.size());
+    // Switches a reference search can find: left below, right above, a home cam between.
+    board.set_input("REF_L_AT", -0.5);
+    board.set_input("REF_R_AT", 0.5);
+    board.set_input("REF_H_FROM", 0.1);
+    board.set_input("REF_H_TO", 0.2);
+    board.before_tick();
+    module = std::make_unique<Tmcm142>(nvm, board.power_stage(), io);
+    module->engine().power_up();
+  }
+  tmcl::TmclEngine& engine() { return module->engine(); }
+  void tick() {
+    board.before_tick();
+    module->tick();
+    board.after_tick(modules::tmcm142::kControlTickS);
+  }
+};
+
+}  // namespace motwin::fuzz
