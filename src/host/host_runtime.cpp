@@ -57,7 +57,11 @@ void HostRuntime::step(uint64_t max_wait_us) {
   if (chunk > 0) advance_ticks(chunk);
   // wait_us() is 0 while a whole batch is already due (catching up, or fast mode).
   const uint64_t now_us = monotonic_now_us();
-  const uint64_t wait_us = now_us < busy_poll_until_us_ ? 0 : pacer_.wait_us(now_us, sim_time_us());
+  // Requests left after a round of serving (a flood) are served after the next poll, which must
+  // not sleep.
+  const bool requests_waiting = service_ && service_->total_queued_requests() > 0 && !service_->reply_held();
+  const uint64_t wait_us =
+      now_us < busy_poll_until_us_ || requests_waiting ? 0 : pacer_.wait_us(now_us, sim_time_us());
   const uint64_t input_events_before = loop_.input_event_count();
   loop_.poll_once(std::min(wait_us, max_wait_us));
   if (service_) service_->serve_queued();

@@ -144,7 +144,8 @@ void TmclHostService::serve_queued() {
   // A reply callback may end up here again (a channel closing); one loop is enough.
   if (serving_) return;
   serving_ = true;
-  while (!held_ && !turns_.empty()) {
+  // Connections that join the round while it runs (their first request read now) wait for the next.
+  for (size_t round = turns_.size(); round > 0 && !held_ && !turns_.empty(); --round) {
     const tmcl::ChannelId turn = turns_.front();
     turns_.pop_front();
     const auto queue = queues_.find(turn);

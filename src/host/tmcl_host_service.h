@@ -91,8 +91,11 @@ class TmclHostService final : public tmcl::ReplySink {
   size_t queued_requests(tmcl::ChannelId id) const;
   size_t total_queued_requests() const { return total_queued_; }
 
-  // Serves queued requests, connections in turn, until none is left or a reply is being held
-  // for its telegram pause (the next request waits for it, as on a half-duplex bus).
+  // Serves one round: one request of each connection that has requests waiting (connections in
+  // turn), stopping early when a reply is being held for its telegram pause (the next request
+  // waits for it, as on a half-duplex bus). The caller polls its descriptors between rounds, so
+  // that a request arriving during a flood joins the next round instead of waiting for every
+  // request queued before it (docs/host-runtime.md, "Serving order").
   void serve_queued();
   // Sends the command 138 replies that have become due. Call after each tick batch. Also
   // notices a power-up that another link caused (255 over CAN), so every link returns to its
