@@ -180,6 +180,9 @@ EmergencyResult Tmcm3216Emergencies::update(uint8_t axis, const AxisConditions& 
     s.levels = static_cast<ConditionMask>(s.levels & ~kWarm);
   }
 
+  // Nothing rose and nothing is promoted: the usual tick of a healthy axis (the table walk below
+  // was a tenth of a whole TMCM-3216 tick).
+  if ((rising | promoted) == 0) return result;
   for (const EmergencyDefinition& row : kTable) {
     const ConditionMask bit = condition_bit(row.condition);
     if ((promoted & bit) != 0 && row.fault_needs_power) {
