@@ -21,20 +21,7 @@
 namespace motwin::host {
 namespace {
 
-struct Pipe {
-  int read_fd = -1;
-  int write_fd = -1;
-  Pipe() {
-    int fds[2];
-    EXPECT_EQ(::pipe(fds), 0);
-    read_fd = fds[0];
-    write_fd = fds[1];
-  }
-  ~Pipe() {
-    ::close(read_fd);
-    ::close(write_fd);
-  }
-};
+using testing::Pipe;
 
 void quiet(const std::string&) {}
 

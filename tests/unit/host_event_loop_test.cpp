@@ -6,24 +6,12 @@
 #include <vector>
 
 #include "host/event_loop.h"
+#include "support/host_test_support.h"
 
 namespace motwin::host {
 namespace {
 
-struct Pipe {
-  int read_fd = -1;
-  int write_fd = -1;
-  Pipe() {
-    int fds[2];
-    EXPECT_EQ(::pipe(fds), 0);
-    read_fd = fds[0];
-    write_fd = fds[1];
-  }
-  ~Pipe() {
-    ::close(read_fd);
-    ::close(write_fd);
-  }
-};
+using testing::Pipe;
 
 TEST(EventLoop, timers_fire_in_due_order_and_cancelled_ones_never) {
   EventLoop loop;

@@ -114,6 +114,22 @@ class TcpTestClient {
   Bytes received_;
 };
 
+// Both ends of a pipe, closed at the end of the test.
+struct Pipe {
+  int read_fd = -1;
+  int write_fd = -1;
+  Pipe() {
+    int fds[2];
+    EXPECT_EQ(::pipe(fds), 0);
+    read_fd = fds[0];
+    write_fd = fds[1];
+  }
+  ~Pipe() {
+    ::close(read_fd);
+    ::close(write_fd);
+  }
+};
+
 // A fresh directory under the temporary directory, removed afterwards.
 class ScratchDirectory {
  public:
