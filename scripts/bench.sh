@@ -6,14 +6,26 @@
 #
 #   scripts/bench.sh                 # the report (a few minutes)
 #   scripts/bench.sh --quick         # shorter runs (rough figures, for trying the script)
+#   scripts/bench.sh --update-docs   # also puts the report into docs/PERFORMANCE.md, between
+#                                    # its "bench.sh report" markers (the prose around them stays)
 #   MOTWIN_BENCH_BUILD=DIR scripts/bench.sh    # another build directory
+#
+# Exit status 1 when a benchmark failed (the report is still written, with the row marked).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${MOTWIN_BENCH_BUILD:-build-release}
 minsize=${MOTWIN_BENCH_MINSIZE_BUILD:-build-minsize}
 jobs=$(nproc 2>/dev/null || echo 2)
 quick=0
-[ "${1:-}" = "--quick" ] && quick=1
+update_docs=0
+for argument in "$@"; do
+  case "$argument" in
+    --quick) quick=1 ;;
+    --update-docs) update_docs=1 ;;
+    *) echo "bench: unknown option '$argument' (--quick, --update-docs)" >&2; exit 2 ;;
+  esac
+done
+failed=()
 
 log() { echo "bench: $*" >&2; }
 
@@ -50,6 +62,7 @@ for bench in "${benches[@]}"; do
   if ! "$build/bench/$bench" "${args[@]}" >"$logs/$bench.txt" 2>"$logs/$bench.err"; then
     log "$bench failed (exit status $?); its output is in $logs/"
     echo "(failed: see $logs/$bench.err)" >>"$logs/$bench.txt"
+    failed+=("$bench")
   fi
 done
 
@@ -113,6 +126,14 @@ if bare and serve and ratio:
                  f"bare TCP echo {bare.group(1)} / {bare.group(2)} us", f"{ratio.group(1)}x / {ratio.group(2)}x"))
 else:
     rows.append(("TMCL round trip over TCP", "n/a", "bare TCP echo", "bench_tcp_roundtrip failed or missing"))
+flooded = re.search(r"motwin serve, (\d+) flooding\s+([\d.]+) us\s+([\d.]+) us\s+\(flood: (\d+) frames/s", tcp)
+flooded_ratio = re.search(r"ratio flooded / idle\s+([\d.]+)x\s+([\d.]+)x", tcp)
+if serve and flooded and flooded_ratio:
+    rows.append((f"TMCL round trip over TCP while {flooded.group(1)} other connections flood the serve "
+                 "(GAP, median / p99)",
+                 f"{flooded.group(2)} / {flooded.group(3)} us ({flooded.group(4)} flood frames/s)",
+                 f"idle serve {serve.group(1)} / {serve.group(2)} us",
+                 f"{flooded_ratio.group(1)}x / {flooded_ratio.group(2)}x"))
 
 can = text("bench_can_roundtrip")
 can_row = r"\s+([\d.]+) us\s+([\d.]+) us\s+(\d+)\s+([\d.]+)x"
@@ -187,3 +208,33 @@ with open(out_path, "w") as f:
 sys.stdout.write(result)
 PYTHON
 log "report written to $build/report.md"
+
+if [ $update_docs = 1 ]; then
+  /usr/bin/python3 - "$build/report.md" docs/PERFORMANCE.md <<'PYTHON'
+import sys
+
+report_path, doc_path = sys.argv[1], sys.argv[2]
+start, end = "<!-- bench.sh report: start -->", "<!-- bench.sh report: end -->"
+with open(report_path) as f:
+    report = f.read().splitlines()
+body = "\n".join(report[1:]).strip()  # without the report's own title
+with open(doc_path) as f:
+    doc = f.read()
+if doc.count(start) != 1 or doc.count(end) != 1 or doc.index(start) > doc.index(end):
+    sys.exit(f"bench: {doc_path} needs one '{start}' line before one '{end}' line")
+before, rest = doc.split(start)
+after = rest.split(end)[1]
+# Headings of the report go one level down, under the document's own section.
+body = "\n".join("#" + line if line.startswith("## ") or line.startswith("### ") else line for line in body.splitlines())
+with open(doc_path + ".tmp", "w") as f:
+    f.write(before + start + "\n\n" + body + "\n\n" + end + after)
+import os
+os.replace(doc_path + ".tmp", doc_path)
+PYTHON
+  log "report put into docs/PERFORMANCE.md"
+fi
+
+if [ ${#failed[@]} -gt 0 ]; then
+  log "failed: ${failed[*]}"
+  exit 1
+fi
