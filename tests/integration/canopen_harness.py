@@ -400,3 +400,14 @@ class RawSdoClient:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def run_can_tests(tests):
+    """motwin_harness.run_tests for scripts that need Debian's python3-can: fails at once, naming
+    the install script, when it is missing."""
+    mh.parse_arguments()  # usage errors (--help, no --motwin) first, as before the python3-can check
+    try:
+        import can  # noqa: F401
+    except ImportError:
+        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
+    mh.run_tests(tests)

@@ -22,16 +22,17 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from can_bus_harness import BusServer, TmclCan  # noqa: E402
 from canopen_harness import (  # noqa: E402
     NMT_RESET_NODE, SAVE, STATE_PREOP, CanopenClient, CanServer, TestFailure, check, check_equal,
+    run_can_tests,
 )
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 4
 NODE_STATS = re.compile(r" node (\S+) bitrate (\d+) (on|off)-speed (\S+) rec (\d+) tec (\d+) missed (\d+) "
                         r"not-sent (\d+) bus-off (\d+)")
 
 
-def serve(tmp, bitrate, *extra):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE,
+def serve(motwin, tmp, bitrate, *extra):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE,
                      extra_args=["--can-bitrate", bitrate, "--can-stats", "0.1"] + list(extra))
 
 
@@ -66,7 +67,7 @@ def silent(bus, what, wait=0.4):
 
 def test_lss_activated_bit_rate_cuts_the_node_off_until_power_up(motwin):
     with TempDir() as tmp:
-        with serve(tmp, "1M") as server, server.bus() as bus:
+        with serve(motwin, tmp, "1M") as server, server.bus() as bus:
             check_equal(bus.upload_u(NODE, 0x2707, 0), 1000, "2707 at start")
             bus.lss([0x04, 0x01], answer=False)  # switch state global: configuration
             check_equal(bus.lss([0x13, 0, 2])[:2], bytes([0x13, 0]), "configure bit timing 500 kbit/s")
@@ -78,7 +79,7 @@ def test_lss_activated_bit_rate_cuts_the_node_off_until_power_up(motwin):
             check_equal(stats[0], 500000, "the node's bit rate in can-stats")
             server.stop()
         # Power-up forgets an activated rate (it was not stored): 2704 = 1000 applies again.
-        with serve(tmp, "1M") as server, server.bus() as bus:
+        with serve(motwin, tmp, "1M") as server, server.bus() as bus:
             check_equal(bus.upload_u(NODE, 0x2707, 0), 1000, "2707 after a restart")
             check_equal(bus.upload_u(NODE, 0x2704, 0), 1000, "2704 unchanged")
             server.stop()
@@ -86,7 +87,7 @@ def test_lss_activated_bit_rate_cuts_the_node_off_until_power_up(motwin):
 
 def test_stored_bit_rate_applies_at_reset_and_the_node_returns_on_a_bus_of_its_rate(motwin):
     with TempDir() as tmp:
-        with serve(tmp, "1M") as server, server.bus() as bus:
+        with serve(motwin, tmp, "1M") as server, server.bus() as bus:
             bus.download(NODE, 0x1017, 0, 100, 2)   # heartbeat every 100 ms
             bus.download(NODE, 0x2704, 0, 500, 2)
             bus.download(NODE, 0x1010, 1, SAVE, 4)  # everything, 2704 and 1017 included
@@ -100,14 +101,14 @@ def test_stored_bit_rate_applies_at_reset_and_the_node_returns_on_a_bus_of_its_r
             stats = wait_for_stats(server, "tmcm-3216", lambda s: s[2] == "error-passive", "error-passive", 6.0)
             check(stats[1] and stats[4] >= 128 and stats[6] >= 16, f"counters of the cut-off node: {stats}")
             server.stop()
-        with serve(tmp, "500k") as server, server.bus() as bus:
+        with serve(motwin, tmp, "500k") as server, server.bus() as bus:
             bus.wait_state(NODE, STATE_PREOP, timeout=1.0)  # its heartbeat reaches the bus
             check_equal(bus.upload_u(NODE, 0x2707, 0), 500, "2707 on a 500 kbit/s bus")
             bus.download(NODE, 0x2704, 0, 1000, 2)
             bus.download(NODE, 0x2706, 1, SAVE, 4)
             silent(bus, "answers after going back to 1 Mbit/s on a 500 kbit/s bus")
             server.stop()
-        with serve(tmp, "1M") as server, server.bus() as bus:
+        with serve(motwin, tmp, "1M") as server, server.bus() as bus:
             check_equal(bus.upload_u(NODE, 0x2707, 0), 1000, "2707 back on 1 Mbit/s")
             bus.nmt(NMT_RESET_NODE, NODE)
             bus.wait_state(NODE, 0x00)
@@ -141,22 +142,12 @@ def test_tmcl_module_off_speed_beside_a_canopen_node(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_lss_activated_bit_rate_cuts_the_node_off_until_power_up,
         test_stored_bit_rate_applies_at_reset_and_the_node_returns_on_a_bus_of_its_rate,
         test_tmcl_module_off_speed_beside_a_canopen_node,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

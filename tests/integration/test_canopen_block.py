@@ -14,18 +14,18 @@ import sys
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import CanServer, TestFailure, check_equal, crc16_ccitt  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import CanServer, check_equal, crc16_ccitt, run_can_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 7
 
 
-def serve(tmp):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE)
+def serve(motwin, tmp):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE)
 
 
 def test_block_upload_with_crc(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         check_equal(bus.block_upload(NODE, 0x1008, 0), b"TMCM-3216", "1008 by block upload")
         check_equal(bus.block_upload(NODE, 0x1008, 0, blksize=1), b"TMCM-3216", "1008 in sub-blocks of 1")
         check_equal(bus.block_upload(NODE, 0x1008, 0, crc=False), b"TMCM-3216", "1008 without CRC")
@@ -34,7 +34,7 @@ def test_block_upload_with_crc(motwin):
 
 
 def test_block_download_with_crc(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.block_download(NODE, 0x1017, 0, struct.pack("<H", 1234))
         check_equal(bus.upload_u(NODE, 0x1017, 0), 1234, "1017 after block download")
         bus.block_download(NODE, 0x1016, 1, struct.pack("<I", 0x00030064), crc=False)
@@ -44,7 +44,7 @@ def test_block_download_with_crc(motwin):
 
 
 def test_wrong_crc_and_bad_block_size_abort(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         value = struct.pack("<H", 777)
         code = bus.abort_code(bus.block_download, NODE, 0x1017, 0, value, True, crc16_ccitt(value) ^ 0x0001)
         check_equal(code, 0x05040004, "wrong CRC")
@@ -57,7 +57,7 @@ def test_wrong_crc_and_bad_block_size_abort(motwin):
 
 
 def test_protocol_switch_threshold(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         # pst 21: 1008 (9 bytes) comes as a normal segmented upload.
         bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 127, 21, 0, 0])
         msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "answer to a block upload with pst")
@@ -68,7 +68,7 @@ def test_protocol_switch_threshold(motwin):
 
 
 def test_client_gone_mid_block_transfer(motwin):
-    with TempDir() as tmp, serve(tmp) as server:
+    with TempDir() as tmp, serve(motwin, tmp) as server:
         with server.bus() as bus:
             bus.send(0x600 + NODE, [0xC6, 0x17, 0x10, 0x00, 2, 0, 0, 0])
             bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block download initiate response")
@@ -83,15 +83,7 @@ def test_client_gone_mid_block_transfer(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_block_upload_with_crc,
         test_block_download_with_crc,
         test_wrong_crc_and_bad_block_size_abort,
@@ -99,8 +91,6 @@ def main():
         test_client_gone_mid_block_transfer,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

@@ -15,14 +15,14 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    NMT_RESET_COMM, SAVE, STATE_BOOTUP, CanServer, TestFailure, check_equal,
+    NMT_RESET_COMM, SAVE, STATE_BOOTUP, CanServer, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 
-def serve(tmp, *extra_args):
+def serve(motwin, tmp, *extra_args):
     # No --node-id: the stored node ID (2705) decides, as LSS needs.
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), extra_args=extra_args)
+    return CanServer(motwin, os.path.join(tmp, "state"), extra_args=extra_args)
 
 
 def identity(bus, node):
@@ -40,7 +40,7 @@ def test_inquire_configure_store_and_restart(motwin):
     with TempDir() as tmp:
         # A bus without bit timing: the node stays reachable when its stored 125 kbit/s applies at
         # the reset (on a timed bus it would be cut off: test_can_bitrate.py).
-        with serve(tmp, "--can-bitrate", "0") as server, server.bus() as bus:
+        with serve(motwin, tmp, "--can-bitrate", "0") as server, server.bus() as bus:
             ident = identity(bus, 1)
             check_equal(bus.lss_silent([0x5E]), [], "inquire in waiting state")
             switch_selective(bus, ident)
@@ -61,7 +61,7 @@ def test_inquire_configure_store_and_restart(motwin):
             check_equal(bus.upload_u(23, 0x2705, 0), 23, "2705 stored by LSS")
             check_equal(bus.upload_u(23, 0x2704, 0), 125, "2704 stored by LSS")
             server.stop()
-        with serve(tmp, "--can-bitrate", "125k") as server, server.bus() as bus:
+        with serve(motwin, tmp, "--can-bitrate", "125k") as server, server.bus() as bus:
             check_equal(bus.upload_u(23, 0x2708, 0), 23, "node ID after a restart")
             check_equal(bus.upload_u(23, 0x2707, 0), 125, "bit rate after a restart")
             server.stop()
@@ -87,13 +87,13 @@ def fast_scan(bus):
 
 def test_unconfigured_node_fastscan_configure_and_boot(motwin):
     with TempDir() as tmp:
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             ident = identity(bus, 1)
             check_equal(fast_scan(bus), None, "fastscan of a configured node")
             bus.download(1, 0x2705, 0, 255, 1)
             bus.download(1, 0x2706, 1, SAVE, 4)
             server.stop()
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             bus.nmt(NMT_RESET_COMM, 0)
             bus.send(0x601, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
             check_equal(bus.collect(0.3, lambda m: m.arbitration_id != 0x7E4), [], "frames of an unconfigured node")
@@ -106,27 +106,17 @@ def test_unconfigured_node_fastscan_configure_and_boot(motwin):
             check_equal(bytes(msg.data), b"\0", "boot-up of the newly configured node")
             check_equal(bus.upload_u(20, 0x1000, 0), 0xFFFF0192, "SDO to the new node ID")
             server.stop()
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             check_equal(bus.upload_u(20, 0x2708, 0), 20, "stored node ID after a restart")
             server.stop()
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_inquire_configure_store_and_restart,
         test_unconfigured_node_fastscan_configure_and_boot,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

@@ -14,16 +14,16 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    NMT_PREOP, NMT_START, SAVE, CanServer, TestFailure, check, check_equal,
+    NMT_PREOP, NMT_START, SAVE, CanServer, check, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 9
 DUMMY_U8, DUMMY_U16, DUMMY_U32 = 0x00050008, 0x00060010, 0x00070020
 
 
-def serve(tmp):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE)
+def serve(motwin, tmp):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE)
 
 
 def pdo_frames(frames, cob_id):
@@ -33,7 +33,7 @@ def pdo_frames(frames, cob_id):
 def test_default_pdos_of_axis_0(motwin):
     # Tables 45/47: TPDO 1 (6041) and TPDO 2 (6041, 6061) are event driven and go out once on
     # entering operational; TPDO 3/4 are synchronous; the PDOs of axes 1 and 2 start disabled.
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.nmt(NMT_START, NODE)
         frames = bus.collect(0.3, lambda m: 0x180 <= m.arbitration_id < 0x580)
         check_equal([(m.arbitration_id, bytes(m.data)) for m in frames],
@@ -43,7 +43,7 @@ def test_default_pdos_of_axis_0(motwin):
 
 
 def test_reconfiguration_in_python_canopen_order_and_event_timer(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         cob_id = 0x180 + NODE
         bus.configure_pdo(NODE, 0x1800, cob_id, 0xFF, [DUMMY_U32, DUMMY_U16], event_ms=100)
         check_equal(bus.upload_u(NODE, 0x1A00, 0), 2, "1A00 sub 0")
@@ -65,7 +65,7 @@ def test_reconfiguration_in_python_canopen_order_and_event_timer(motwin):
 
 
 def test_mapping_refusals(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         check_equal(bus.abort_code(bus.download, NODE, 0x1A01, 0, 0, 1), 0x08000022, "mapping of a valid PDO")
         bus.download(NODE, 0x1801, 1, 0x80000280 + NODE, 4)
         bus.download(NODE, 0x1A01, 0, 0, 1)
@@ -81,7 +81,7 @@ def test_mapping_refusals(motwin):
 
 
 def test_rpdo_length_errors_send_emcy(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.configure_pdo(NODE, 0x1400, 0x200 + NODE, 0xFF, [DUMMY_U16, DUMMY_U8])
         bus.nmt(NMT_START, NODE)
         bus.drain(0.05)
@@ -101,11 +101,11 @@ def test_rpdo_length_errors_send_emcy(motwin):
 
 def test_pdo_configuration_survives_store_and_restart(motwin):
     with TempDir() as tmp:
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             bus.configure_pdo(NODE, 0x1801, 0x280 + NODE, 0xFE, [DUMMY_U8], event_ms=50)
             bus.download(NODE, 0x1010, 1, SAVE, 4)
             server.stop()
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             check_equal(bus.upload_u(NODE, 0x1801, 2), 0xFE, "1801 sub 2 after restart")
             check_equal(bus.upload_u(NODE, 0x1A01, 0), 1, "1A01 sub 0 after restart")
             check_equal(bus.upload_u(NODE, 0x1A01, 1), DUMMY_U8, "1A01 sub 1 after restart")
@@ -117,15 +117,7 @@ def test_pdo_configuration_survives_store_and_restart(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_default_pdos_of_axis_0,
         test_reconfiguration_in_python_canopen_order_and_event_timer,
         test_mapping_refusals,
@@ -133,8 +125,6 @@ def main():
         test_pdo_configuration_survives_store_and_restart,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

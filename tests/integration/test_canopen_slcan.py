@@ -20,20 +20,20 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
     LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
-    STATE_PREOP, STATE_STOPPED, CanServer, TestFailure, check, check_equal,
+    STATE_PREOP, STATE_STOPPED, CanServer, TestFailure, check, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 7
 
 
-def serve(tmp):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE,
+def serve(motwin, tmp):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE,
                      can=("slcan-tcp:127.0.0.1:0", "socketcand:127.0.0.1:0"))
 
 
 def test_slcan_sdo_and_nmt(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.slcan_bus() as bus:
         bus.nmt(NMT_RESET_NODE, NODE)
         bus.wait_state(NODE, STATE_BOOTUP)
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 over SLCAN")
@@ -46,7 +46,7 @@ def test_slcan_sdo_and_nmt(motwin):
 
 
 def test_slcan_and_socketcand_share_the_bus(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as slcan, server.bus() as socketcand:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.slcan_bus() as slcan, server.bus() as socketcand:
         socketcand.drain(0.1)
         slcan.send(0x321, [9, 8, 7])
         msg = socketcand.receive(lambda m: m.arbitration_id == 0x321, 1.0, "SLCAN frame at the socketcand client")
@@ -75,7 +75,7 @@ def test_slcan_pdo_sync_and_emcy(motwin):
     """PDO reconfiguration in python-canopen's order, a SYNC-driven TPDO, an event-timer TPDO and
     the RPDO length EMCYs, all through the SLCAN adapter (python-can stamps SLCAN frames with wall
     time, so counts are checked, not gaps)."""
-    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.slcan_bus() as bus:
         tpdo1, tpdo2, rpdo1, emcy = 0x180 + NODE, 0x280 + NODE, 0x200 + NODE, 0x80 + NODE
         bus.configure_pdo(NODE, 0x1800, tpdo1, 3, [DUMMY_U16])
         bus.configure_pdo(NODE, 0x1801, tpdo2, 0xFF, [DUMMY_U8], event_ms=100)
@@ -102,7 +102,7 @@ def test_slcan_pdo_sync_and_emcy(motwin):
 
 
 def test_slcan_nmt_transitions(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.slcan_bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.slcan_bus() as bus:
         bus.download(NODE, 0x1017, 0, 1000, 2)  # state changes show as extra heartbeats at once
         bus.wait_state(NODE, STATE_PREOP)
         bus.nmt(NMT_START, NODE)
@@ -122,13 +122,13 @@ def test_slcan_nmt_transitions(motwin):
 
 def test_slcan_store_and_restore_across_restart(motwin):
     with TempDir() as tmp:
-        with serve(tmp) as server, server.slcan_bus() as bus:
+        with serve(motwin, tmp) as server, server.slcan_bus() as bus:
             bus.download(NODE, 0x1017, 0, 250, 2)
             bus.configure_pdo(NODE, 0x1802, 0x380 + NODE, 7, [DUMMY_U8])
             bus.download(NODE, 0x1010, 1, SAVE, 4)
             bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
             server.stop()
-        with serve(tmp) as server, server.slcan_bus() as bus:
+        with serve(motwin, tmp) as server, server.slcan_bus() as bus:
             check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
             check_equal(bus.upload_u(NODE, 0x1802, 2), 7, "1802 sub 2 after restart")
             check_equal([bus.upload_u(NODE, 0x1A02, sub) for sub in (0, 1)], [1, DUMMY_U8], "1A02 after restart")
@@ -177,7 +177,7 @@ def test_slcan_lss_configure_and_fastscan(motwin):
     node made unconfigured (2705 = 255), found by fastscan, configured and booted: all over SLCAN."""
     with TempDir() as tmp:
         state = os.path.join(tmp, "state")
-        with CanServer(MOTWIN, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
+        with CanServer(motwin, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
             ident = [bus.upload_u(1, 0x1018, sub) for sub in (1, 2, 3, 4)]
             check_equal(ident, [0x286, 3216, 0x00010004, 1], "identity of node 1")
             for command, value in zip((0x40, 0x41, 0x42), ident[:3]):
@@ -196,7 +196,7 @@ def test_slcan_lss_configure_and_fastscan(motwin):
             bus.download(23, 0x2705, 0, 255, 1)
             bus.download(23, 0x2706, 1, SAVE, 4)
             server.stop()
-        with CanServer(MOTWIN, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
+        with CanServer(motwin, state, can=("slcan-tcp:127.0.0.1:0",)) as server, server.slcan_bus() as bus:
             bus.send(0x623, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
             check_equal(bus.collect(0.3, lambda m: m.arbitration_id != 0x7E4), [], "frames of an unconfigured node")
             check_equal(fast_scan(bus), ident, "identity found by fastscan")
@@ -238,7 +238,7 @@ class RawSlcan:
 
 
 def test_slcan_adapter_commands(motwin):
-    with TempDir() as tmp, serve(tmp) as server:
+    with TempDir() as tmp, serve(motwin, tmp) as server:
         raw = RawSlcan(server.slcan_port)
         try:
             check_equal(raw.command("V"), b"V1013\r", "version")
@@ -260,16 +260,10 @@ def test_slcan_adapter_commands(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    run_tests([test_slcan_sdo_and_nmt, test_slcan_and_socketcand_share_the_bus, test_slcan_adapter_commands,
-               test_slcan_pdo_sync_and_emcy, test_slcan_nmt_transitions, test_slcan_store_and_restore_across_restart,
-               test_slcan_lss_configure_and_fastscan])
+    run_can_tests([test_slcan_sdo_and_nmt, test_slcan_and_socketcand_share_the_bus, test_slcan_adapter_commands,
+                   test_slcan_pdo_sync_and_emcy, test_slcan_nmt_transitions,
+                   test_slcan_store_and_restore_across_restart, test_slcan_lss_configure_and_fastscan])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

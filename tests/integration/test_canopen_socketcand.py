@@ -18,19 +18,19 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
     LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
-    STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, TestFailure, check, check_equal,
+    STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, check, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 5
 
 
-def serve(tmp, **kwargs):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=kwargs.pop("node_id", NODE), **kwargs)
+def serve(motwin, tmp, **kwargs):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=kwargs.pop("node_id", NODE), **kwargs)
 
 
 def test_bootup_after_nmt_reset(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.nmt(NMT_RESET_NODE, NODE)
         msg = bus.wait_state(NODE, STATE_BOOTUP)
         check_equal(bytes(msg.data), b"\x00", "boot-up data")
@@ -43,7 +43,7 @@ def test_bootup_after_nmt_reset(motwin):
 
 
 def test_sdo_reads_of_identity_objects(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 device type")
         check_equal(bus.upload_u(NODE, 0x1018, 0), 4, "1018 sub 0")
         check_equal(bus.upload_u(NODE, 0x1018, 1), 0x286, "1018 vendor ID")
@@ -58,7 +58,7 @@ def test_sdo_reads_of_identity_objects(motwin):
 
 
 def test_heartbeat_at_the_1017_period(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.download(NODE, 0x1017, 0, 100, 2)
         check_equal(bus.upload_u(NODE, 0x1017, 0), 100, "1017 read back")
         beats = bus.collect(1.2, lambda m: m.arbitration_id == 0x700 + NODE)
@@ -75,7 +75,7 @@ def test_heartbeat_at_the_1017_period(motwin):
 
 
 def test_abort_codes(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         check_equal(bus.abort_code(bus.upload, NODE, 0x1234, 0), 0x06020000, "absent object")
         check_equal(bus.abort_code(bus.upload, NODE, 0x6043, 0), 0x06020000, "object not in the dictionary (vl mode)")
         check_equal(bus.abort_code(bus.upload, NODE, 0x1018, 9), 0x06090011, "absent sub-index")
@@ -94,7 +94,7 @@ def test_abort_codes(motwin):
 
 
 def test_nmt_start_stop_preop(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.download(NODE, 0x1017, 0, 50, 2)
         bus.wait_state(NODE, STATE_PREOP)
         bus.nmt(NMT_START, NODE)
@@ -113,13 +113,13 @@ def test_nmt_start_stop_preop(motwin):
 
 def test_store_and_restore_across_restart(motwin):
     with TempDir() as tmp:
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             bus.download(NODE, 0x1017, 0, 250, 2)
             bus.download(NODE, 0x1029, 1, 2, 1)
             bus.download(NODE, 0x1010, 1, SAVE, 4)
             bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
             server.stop()
-        with serve(tmp) as server, server.bus() as bus:
+        with serve(motwin, tmp) as server, server.bus() as bus:
             check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
             check_equal(bus.upload_u(NODE, 0x1029, 1), 2, "1029 sub 1 after restart")
             check_equal(bus.upload_u(NODE, 0x1015, 0), 0, "unsaved 1015 after restart")
@@ -133,7 +133,7 @@ def test_store_and_restore_across_restart(motwin):
 
 def test_node_id_through_2705_and_2706(motwin):
     with TempDir() as tmp:
-        with serve(tmp, node_id=None) as server, server.bus() as bus:
+        with serve(motwin, tmp, node_id=None) as server, server.bus() as bus:
             check_equal(bus.upload_u(1, 0x2708, 0), 1, "default node ID")
             bus.download(1, 0x2705, 0, 33, 1)
             bus.download(1, 0x2706, 1, SAVE, 4)
@@ -141,13 +141,13 @@ def test_node_id_through_2705_and_2706(motwin):
             bus.wait_state(33, STATE_BOOTUP)
             check_equal(bus.upload_u(33, 0x1014, 0), 0x80 + 33, "EMCY COB-ID follows the node ID")
             server.stop()
-        with serve(tmp, node_id=None) as server, server.bus() as bus:
+        with serve(motwin, tmp, node_id=None) as server, server.bus() as bus:
             check_equal(bus.upload_u(33, 0x2708, 0), 33, "stored node ID after restart")
             server.stop()
 
 
 def test_clients_see_each_other_but_not_themselves(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as a, server.bus() as b:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as a, server.bus() as b:
         a.drain(0.1)
         b.drain(0.1)
         a.send(0x123, [1, 2, 3])
@@ -164,7 +164,7 @@ def test_clients_see_each_other_but_not_themselves(motwin):
 
 
 def test_garbage_and_malformed_elements_are_tolerated(motwin):
-    with TempDir() as tmp, serve(tmp) as server:
+    with TempDir() as tmp, serve(motwin, tmp) as server:
         raw = RawSocketcand(server.can_port)
         try:
             check_equal(raw.read_element(), "< hi >", "greeting")
@@ -197,7 +197,7 @@ def test_garbage_and_malformed_elements_are_tolerated(motwin):
 
 
 def test_client_disconnect_mid_transfer(motwin):
-    with TempDir() as tmp, serve(tmp) as server:
+    with TempDir() as tmp, serve(motwin, tmp) as server:
         with server.bus() as bus:
             bus.send(0x600 + NODE, [0x40, 0x08, 0x10, 0, 0, 0, 0, 0])  # segmented upload started
             bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "initiate response")
@@ -212,7 +212,7 @@ def test_malformed_sdo_frames_on_the_wire(motwin):
     """Robustness with raw frames: an SDO request of 4 bytes, command specifier 7 and an upload
     segment with the wrong toggle bit are aborted (05040001, 05040001, 05030000), and the server
     goes on serving."""
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         def exchange(data):
             bus.send(0x600 + NODE, data)
             msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, f"answer to {bytes(data).hex()}")
@@ -236,7 +236,7 @@ def test_malformed_sdo_frames_on_the_wire(motwin):
 def test_heartbeat_consumer_emcy(motwin):
     """The master (node 0x10 here) sends heartbeats, then stops: EMCY 8130 with 1001 bit 4 (and
     bit 0), 1029 sub 1 = 0 stops the operational node; the next heartbeat gives EMCY 0000."""
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.download(NODE, 0x1016, 1, (0x10 << 16) | 200, 4)  # producer 0x10, 200 ms
         bus.download(NODE, 0x1017, 0, 50, 2)
         bus.nmt(NMT_START, NODE)
@@ -265,7 +265,7 @@ def test_bus_capture_pcap_and_candump(motwin):
     with TempDir() as tmp:
         for name in ("bus.pcap", "bus.log"):
             path = os.path.join(tmp, name)
-            with serve(tmp, extra_args=("--can-capture", path)) as server, server.bus() as bus:
+            with serve(motwin, tmp, extra_args=("--can-capture", path)) as server, server.bus() as bus:
                 bus.nmt(NMT_RESET_NODE, NODE)
                 bus.wait_state(NODE, STATE_BOOTUP)
                 check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000")
@@ -305,8 +305,8 @@ def test_serve_argument_errors(motwin):
     ]
     with TempDir() as tmp:
         for extra, expected in cases:
-            server = CanServer(MOTWIN, "none")
-            server.args = [MOTWIN, "serve", "--module", "tmcm-3216", "--state-dir", "none"] + extra
+            server = CanServer(motwin, "none")
+            server.args = [motwin, "serve", "--module", "tmcm-3216", "--state-dir", "none"] + extra
             try:
                 check_equal(server.start_expect_failure(), 2, f"exit status for {extra}")
                 lines = server.stderr_lines()
@@ -318,15 +318,7 @@ def test_serve_argument_errors(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_bootup_after_nmt_reset,
         test_sdo_reads_of_identity_objects,
         test_heartbeat_at_the_1017_period,
@@ -343,8 +335,6 @@ def main():
         test_serve_argument_errors,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

@@ -11,15 +11,15 @@ import sys
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import NMT_PREOP, NMT_START, NMT_STOP, CanServer, TestFailure, check, check_equal  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import NMT_PREOP, NMT_START, NMT_STOP, CanServer, check, check_equal, run_can_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 11
 DUMMY_U16 = 0x00060010
 
 
-def serve(tmp):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE)
+def serve(motwin, tmp):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE)
 
 
 def sync_and_collect(bus, count, cob_id, sync_id=0x080):
@@ -33,7 +33,7 @@ def sync_and_collect(bus, count, cob_id, sync_id=0x080):
 
 
 def test_synchronous_tpdos_count_master_syncs(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         tpdo3 = 0x380 + NODE
         bus.configure_pdo(NODE, 0x1802, tpdo3, 3, [DUMMY_U16])
         check_equal(sync_and_collect(bus, 4, tpdo3), [], "TPDOs at SYNCs in pre-operational")
@@ -50,7 +50,7 @@ def test_synchronous_tpdos_count_master_syncs(motwin):
 
 
 def test_sync_producer_drives_own_synchronous_tpdos(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         tpdo1 = 0x180 + NODE
         bus.configure_pdo(NODE, 0x1800, tpdo1, 2, [DUMMY_U16])
         bus.download(NODE, 0x1006, 0, 20000, 4)        # 20 ms
@@ -80,21 +80,11 @@ def test_sync_producer_drives_own_synchronous_tpdos(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_synchronous_tpdos_count_master_syncs,
         test_sync_producer_drives_own_synchronous_tpdos,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

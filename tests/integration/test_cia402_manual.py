@@ -12,16 +12,17 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import NMT_RESET_NODE, STATE_BOOTUP, CanServer, TestFailure, check, check_equal  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import (NMT_RESET_NODE, STATE_BOOTUP, CanServer, TestFailure, check,  # noqa: E402
+                             check_equal, run_can_tests)
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 3
 SPEED = "20"  # simulated seconds per wall second
 USTEPS_PER_REV = 256 * 200
 
 
-def serve(tmp, *extra):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE, speed=SPEED, extra_args=extra)
+def serve(motwin, tmp, *extra):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE, speed=SPEED, extra_args=extra)
 
 
 def reset(bus):
@@ -47,7 +48,7 @@ def i32(value):
 
 
 def test_manual_6_2_profile_position(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x2005, 0, 3, 4)        # no limit switches connected
         bus.download(NODE, 0x6060, 0, 1, 1)        # pp
@@ -75,7 +76,7 @@ def test_manual_6_2_profile_position(motwin):
 
 
 def test_manual_7_2_profile_velocity(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x2005, 0, 3, 4)
         bus.download(NODE, 0x6060, 0, 3, 1)        # pv
@@ -97,7 +98,7 @@ def test_manual_7_2_profile_velocity(motwin):
 
 def test_manual_8_3_homing_method_19(motwin):
     # The home switch of motor 0 is high from one motor revolution on.
-    with TempDir() as tmp, serve(tmp, "--set", "AXIS0_REF_H_AT=1.0") as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp, "--set", "AXIS0_REF_H_AT=1.0") as server, server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x6060, 0, 6, 1)        # hm
         for cw in (6, 7, 15):
@@ -124,22 +125,12 @@ def test_manual_8_3_homing_method_19(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_manual_6_2_profile_position,
         test_manual_7_2_profile_velocity,
         test_manual_8_3_homing_method_19,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

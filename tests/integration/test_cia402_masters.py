@@ -16,8 +16,8 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (NMT_RESET_NODE, NMT_START, NMT_STOP, STATE_BOOTUP, CanServer,  # noqa: E402
-                             TestFailure, check, check_equal)
-from motwin_harness import TempDir, run_tests  # noqa: E402
+                             TestFailure, check, check_equal, run_can_tests)
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 4
 SPEED = "10"
@@ -36,8 +36,8 @@ STATES = {
 }
 
 
-def serve(tmp, *extra):
-    return CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE, speed=SPEED, extra_args=extra)
+def serve(motwin, tmp, *extra):
+    return CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE, speed=SPEED, extra_args=extra)
 
 
 def reset(bus):
@@ -80,7 +80,7 @@ def wait_status(bus, mask, value, timeout, axis=0):
 
 
 def test_device_type_and_supported_modes_per_axis(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000: multi-device module, profile 402")
         for axis in range(3):
             check_equal(bus.upload_u(NODE, 0x67FF + axis * AXIS, 0), 0x00840192, f"67FF axis {axis}")
@@ -91,7 +91,7 @@ def test_device_type_and_supported_modes_per_axis(motwin):
 
 
 def test_python_canopen_state_transitions(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         axis = 1
         bus.download(NODE, 0x2205, 0, 3, 4)
@@ -140,7 +140,7 @@ def test_python_canopen_state_transitions(motwin):
 
 
 def test_fault_and_fault_reset_with_emcy(motwin):
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         bus.nmt(NMT_START, NODE)
         axis = 2
@@ -168,7 +168,7 @@ def test_fault_and_fault_reset_with_emcy(motwin):
 
 
 def test_homing_statusword_contract(motwin):
-    with TempDir() as tmp, serve(tmp, "--set", "AXIS0_REF_H_AT=0.5") as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp, "--set", "AXIS0_REF_H_AT=0.5") as server, server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x6060, 0, 6, 1)
         bus.download(NODE, 0x6098, 0, 19, 1)
@@ -202,7 +202,7 @@ def test_homing_statusword_contract(motwin):
 def test_pdo_operation_profile_velocity(motwin):
     """The default PDOs of axis 0 (tables 41-47): RPDO 1 = 6040, RPDO 4 = 6040 + 60FF,
     TPDO 1 = 6041 (event driven), TPDO 4 = 6041 + 606C (every SYNC)."""
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x2005, 0, 3, 4)
         bus.download(NODE, 0x6060, 0, 3, 1)
@@ -231,7 +231,7 @@ def test_csp_driven_by_sync_and_rpdo(motwin):
     1000 µs), the master answers every SYNC with RPDO 3 (6040 + 607A), TPDO 3 (6041 + 6064) comes
     at every SYNC. The axis follows the set-points: each reported position is one that was sent
     (the demand lands on every set-point one period after the SYNC that took it)."""
-    with TempDir() as tmp, CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE, speed="0.2") as server, \
+    with TempDir() as tmp, CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE, speed="0.2") as server, \
             server.bus() as bus:
         reset(bus)
         bus.download(NODE, 0x2005, 0, 3, 4)
@@ -285,7 +285,7 @@ def test_pdo_setup_of_axis_1_in_master_order(motwin):
     6841 + 6864 (every SYNC) in python-canopen's order, make them valid, and run a pp move of
     axis 1 through them: the set-point handshake and the arrival show in the TPDO."""
     rpdo_cob, tpdo_cob = 0x220 + NODE, 0x1A0 + NODE
-    with TempDir() as tmp, serve(tmp) as server, server.bus() as bus:
+    with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         reset(bus)
         check_equal(bus.upload_u(NODE, 0x1440, 1) & 0x80000000, 0x80000000, "axis 1 RPDO 1 starts not valid")
         check_equal(bus.upload_u(NODE, 0x1640, 1), 0x68400010, "axis 1 RPDO 1 maps its own 6840")
@@ -331,15 +331,7 @@ def i32(value):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_device_type_and_supported_modes_per_axis,
         test_python_canopen_state_transitions,
         test_fault_and_fault_reset_with_emcy,
@@ -349,8 +341,6 @@ def main():
         test_pdo_setup_of_axis_1_in_master_order,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

@@ -13,18 +13,18 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import NMT_START, CanServer, TestFailure, check, check_equal  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import NMT_START, CanServer, check, check_equal, run_can_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 6
 BLOCK_AT_S = 6.0  # simulated seconds after start (3 s of wall time at --speed 2)
 
 
-def stall_run(tmp, option):
+def stall_run(motwin, tmp, option):
     scenario = os.path.join(tmp, "scenario.txt")
     with open(scenario, "w") as f:
         f.write(f"{BLOCK_AT_S} AXIS0_BLOCKED 1\n")
-    server = CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE, speed="2",
+    server = CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE, speed="2",
                        extra_args=["--motor", "nema17", "--scenario", scenario])
     with server, server.bus() as bus:
         bus.nmt(NMT_START, NODE)
@@ -56,32 +56,22 @@ def stall_run(tmp, option):
 
 def test_stall_enters_fault_with_option_0(motwin):
     with TempDir() as tmp:
-        status = stall_run(tmp, 0)
+        status = stall_run(motwin, tmp, 0)
         check_equal(status & 0x4F, 0x08, f"FAULT after the stall (6041 = {status:#06x})")
 
 
 def test_stall_only_stops_with_option_1(motwin):
     with TempDir() as tmp:
-        status = stall_run(tmp, 1)
+        status = stall_run(motwin, tmp, 1)
         check_equal(status & 0x6F, 0x27, f"still OPERATION ENABLED (6041 = {status:#06x})")
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_stall_enters_fault_with_option_0,
         test_stall_only_stops_with_option_1,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

@@ -12,8 +12,8 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import NMT_START, CanServer, TestFailure, check, check_equal  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import NMT_START, CanServer, check, check_equal, run_can_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 9
 ABORT_INVALID_VALUE = 0x06090030
@@ -22,7 +22,7 @@ ABORT_DEVICE_STATE = 0x08000022
 
 def test_inputs_outputs_and_switches(motwin):
     with TempDir() as tmp:
-        server = CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE,
+        server = CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE,
                            extra_args=["--set", "DIO2=1", "--set", "AIN1=1234", "--set", "AXIS0_REF_L=1",
                                        "--set", "AXIS1_REF_H=1"])
         with server, server.bus() as bus:
@@ -55,7 +55,7 @@ def test_inputs_outputs_and_switches(motwin):
 
 def test_stepper_objects_and_states(motwin):
     with TempDir() as tmp:
-        server = CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE,
+        server = CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE,
                            extra_args=["--set", "AXIS2_DRIVER_TEMP=130"])
         with server, server.bus() as bus:
             bus.nmt(NMT_START, NODE)
@@ -85,21 +85,11 @@ def test_stepper_objects_and_states(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_inputs_outputs_and_switches,
         test_stepper_objects_and_states,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()

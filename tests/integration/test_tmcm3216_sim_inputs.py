@@ -14,8 +14,8 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from canopen_harness import NMT_START, CanServer, TestFailure, check, check_equal  # noqa: E402
-from motwin_harness import TempDir, run_tests  # noqa: E402
+from canopen_harness import NMT_START, CanServer, check, check_equal, run_can_tests  # noqa: E402
+from motwin_harness import TempDir  # noqa: E402
 
 NODE = 5
 OPEN_AT_S = 1.5   # simulated seconds after start
@@ -32,7 +32,7 @@ def test_shutdown_switch_from_a_scenario(motwin):
         scenario = os.path.join(tmp, "scenario.txt")
         with open(scenario, "w") as f:
             f.write(f"{OPEN_AT_S} ENABLE 0\n{CLOSE_AT_S} ENABLE 1\n")
-        server = CanServer(MOTWIN, os.path.join(tmp, "state"), node_id=NODE,
+        server = CanServer(motwin, os.path.join(tmp, "state"), node_id=NODE,
                            extra_args=["--motor", "nema17,ideal,nema23", "--scenario", scenario])
         with server, server.bus() as bus:
             start = time.monotonic()
@@ -73,7 +73,7 @@ def test_motor_list_errors(motwin):
         for motors, expected in (("nema17,ideal", "names 2 motors for 3 axes"),
                                  ("nema17,nema99,ideal", "motor of axis 1: unknown stepper motor \"nema99\"")):
             state = os.path.join(tmp, "state")
-            result = subprocess.run([MOTWIN, "serve", "--module", "tmcm-3216", "--node-id", "1", "--state-dir", state,
+            result = subprocess.run([motwin, "serve", "--module", "tmcm-3216", "--node-id", "1", "--state-dir", state,
                                      "--can", "socketcand:127.0.0.1:0", "--motor", motors],
                                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=20)
             check(result.returncode != 0, f"--motor {motors}: exit status {result.returncode}")
@@ -83,21 +83,11 @@ def test_motor_list_errors(motwin):
 
 
 def main():
-    global MOTWIN
-    import motwin_harness
-    args = motwin_harness.parse_arguments()
-    MOTWIN = os.path.abspath(args.motwin)
-    try:
-        import can  # noqa: F401
-    except ImportError:
-        raise TestFailure("python3-can is missing: run scripts/install-deps.sh")
-    run_tests([
+    run_can_tests([
         test_shutdown_switch_from_a_scenario,
         test_motor_list_errors,
     ])
 
-
-MOTWIN = None
 
 if __name__ == "__main__":
     main()
