@@ -7,19 +7,13 @@
 // ever asserted. See docs/benchmarks.md.
 //
 //   bench_tcp_roundtrip [PATH/TO/motwin] [--requests N] [--flooders N]
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <netinet/tcp.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -29,6 +23,7 @@
 #include <vector>
 
 #include "core/tmcl/serial_link.h"
+#include "host/tmcl_host_service.h"
 #include "tools/fd_io.h"
 #include "tools/loopback_frame_server.h"
 #include "tools/serve_process.h"
@@ -46,9 +41,9 @@ constexpr size_t kWarmupRequests = 1000;
 // hits all alike.
 constexpr size_t kBlockRequests = 1000;
 constexpr size_t kDefaultFlooders = 4;
-// Requests each flooding connection keeps in flight: TmclHostService::kMaxQueuedRequestsPerChannel,
-// as many as the server queues for one connection before it stops reading it.
-constexpr size_t kFloodWindow = 32;
+// Requests each flooding connection keeps in flight: as many as the server queues for one
+// connection before it stops reading it.
+constexpr size_t kFloodWindow = host::TmclHostService::kMaxQueuedRequestsPerChannel;
 
 struct Options {
   std::string motwin_path;
@@ -123,22 +118,6 @@ struct FloodConnection {
   uint64_t answered = 0;
   std::string error;
 };
-
-tools::Result<tools::UniqueFd> connect_loopback(const std::string& address) {
-  const std::optional<int64_t> port = tools::parse_integer(address.substr(address.rfind(':') + 1));
-  if (!port || *port < 1 || *port > 65535) return tools::Error{"bad address " + address};
-  tools::UniqueFd fd(::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0));
-  sockaddr_in peer{};
-  peer.sin_family = AF_INET;
-  peer.sin_port = htons(static_cast<uint16_t>(*port));
-  peer.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (!fd.valid() || ::connect(fd.get(), reinterpret_cast<const sockaddr*>(&peer), sizeof(peer)) != 0) {
-    return tools::Error{"cannot connect to " + address + ": " + std::strerror(errno)};
-  }
-  const int on = 1;
-  ::setsockopt(fd.get(), IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
-  return fd;
-}
 
 void flood_until_stopped(FloodConnection& connection, const tmcl::Frame& request, const std::atomic<bool>& stop) {
   std::vector<uint8_t> batch;
@@ -229,7 +208,7 @@ int main(int argc, char** argv) {
   serve_client->set_reply_timeout(std::chrono::seconds(10));
   std::vector<FloodConnection> flooders(options->flooders);
   for (FloodConnection& flooder : flooders) {
-    tools::Result<tools::UniqueFd> fd = connect_loopback(*serve_address);
+    tools::Result<tools::UniqueFd> fd = tools::connect_tcp_socket(*serve_address, std::chrono::seconds(5));
     if (!fd) return fail(fd.error());
     flooder.fd = std::move(fd.value());
   }

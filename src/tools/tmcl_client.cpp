@@ -127,7 +127,7 @@ Result<TmclReply> decode_reply(const Frame& bytes, const Instruction& request) {
   return reply;
 }
 
-Result<TmclClient> TmclClient::connect_tcp(std::string_view host_and_port, std::chrono::milliseconds connect_timeout) {
+Result<UniqueFd> connect_tcp_socket(std::string_view host_and_port, std::chrono::milliseconds connect_timeout) {
   Result<HostAndPort> target = split_host_and_port(host_and_port);
   if (!target) return Error{target.error()};
   addrinfo hints{};
@@ -148,10 +148,14 @@ Result<TmclClient> TmclClient::connect_tcp(std::string_view host_and_port, std::
     last_error = fd.error();
   }
   ::freeaddrinfo(addresses);
-  if (!connected.valid()) {
-    return Error{fmt::format("cannot connect to {}: {}", host_and_port, last_error)};
-  }
-  return TmclClient(std::move(connected), true, fmt::format("tcp {}", host_and_port));
+  if (!connected.valid()) return Error{fmt::format("cannot connect to {}: {}", host_and_port, last_error)};
+  return connected;
+}
+
+Result<TmclClient> TmclClient::connect_tcp(std::string_view host_and_port, std::chrono::milliseconds connect_timeout) {
+  Result<UniqueFd> connected = connect_tcp_socket(host_and_port, connect_timeout);
+  if (!connected) return Error{connected.error()};
+  return TmclClient(std::move(connected.value()), true, fmt::format("tcp {}", host_and_port));
 }
 
 Result<TmclClient> TmclClient::open_serial(const std::string& device_path) {

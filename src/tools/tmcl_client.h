@@ -48,6 +48,10 @@ Result<TmclReply> decode_reply(const tmcl::Frame& bytes, const tmcl::Instruction
 // "02 01 64 06 00 00 00 2A 91".
 std::string hex_bytes(const uint8_t* bytes, size_t length);
 
+// A blocking TCP socket connected to `host_and_port` ("127.0.0.1:5000", "[::1]:5000"), with
+// TCP_NODELAY (small requests leave at once); an unreachable address fails within the timeout.
+Result<UniqueFd> connect_tcp_socket(std::string_view host_and_port, std::chrono::milliseconds connect_timeout);
+
 class TmclClient {
  public:
   // `host_and_port`: "127.0.0.1:5000", "localhost:5000" or "[::1]:5000".
