@@ -11,7 +11,7 @@
 
 #include "board/can_controller.h"
 #include "board/ram_non_volatile_memory.h"
-#include "board/tmcm1636_io.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
 #include "core/can/can_frame.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/modules/tmcm3216/tmcm3216.h"

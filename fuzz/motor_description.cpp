@@ -1,4 +1,4 @@
-// Motor description files (src/sim/motor_description.*): any JSON text.
+// Motor description files (src/sim/modules/tmcm1636/motor_description.*): any JSON text.
 //
 // Invariants: a description that loads is written back by motor_description_json() as text that
 // loads again and is written back identically (a fixed point after one round); a simulated
@@ -11,9 +11,9 @@
 #include <string_view>
 
 #include "fuzz_support.h"
-#include "sim/motor_description.h"
-#include "sim/tmcm1636_sim_board.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/motor_description.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace motwin;

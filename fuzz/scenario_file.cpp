@@ -16,11 +16,11 @@
 #include "scenario_checks.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
-#include "sim/tmcm142_sim_board.h"
-#include "sim/tmcm142_sim_io.h"
-#include "sim/tmcm1636_sim_board.h"
-#include "sim/tmcm1636_sim_io.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// The TMCM-142's simulated board (src/sim/tmcm142_sim_board.*) with its files: a stepper motor
+// The TMCM-142's simulated board (src/sim/modules/tmcm142/tmcm142_sim_board.*) with its files: a stepper motor
 // description (src/sim/stepper_motor_selection.*: any JSON text) and a scenario file against
 // the board's signal table (src/sim/scenario.*), run under the TMCM-142 firmware.
 //
@@ -35,8 +35,8 @@
 #include "scenario_checks.h"
 #include "sim/scenario.h"
 #include "sim/stepper_motor_selection.h"
-#include "sim/tmcm142_sim_board.h"
-#include "sim/tmcm142_sim_io.h"
+#include "sim/modules/tmcm142/tmcm142_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
 
 namespace {
 

@@ -8,8 +8,8 @@
 #include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm142/tmcm142.h"
 #include "core/tmcl/engine.h"
-#include "sim/tmcm142_sim_board.h"
-#include "sim/tmcm142_sim_io.h"
+#include "sim/modules/tmcm142/tmcm142_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
 
 namespace motwin::fuzz {
 

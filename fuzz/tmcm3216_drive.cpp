@@ -26,7 +26,7 @@
 
 #include "canopen_checks.h"
 #include "core/cia402/power_drive_system.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 namespace {
 

@@ -44,7 +44,7 @@
 #include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
-#include "sim/motor_description.h"
+#include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
 

@@ -1,9 +1,9 @@
 #include "host/module_registry.h"
 
-#include "host/tmcm142_virtual_module.h"
-#include "host/tmcm1636_virtual_module.h"
-#include "host/tmcm3216_virtual_module.h"
-#include "sim/tmcm1636_sim_board.h"
+#include "host/modules/tmcm142/tmcm142_virtual_module.h"
+#include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
 
 namespace motwin::host {
 namespace {

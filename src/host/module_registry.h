@@ -27,7 +27,7 @@ struct ModuleOptions {
   // Input levels set before power-up (`--set`), already checked against input_signals.
   std::vector<InitialInput> initial_inputs;
   // The motor: "ideal" or empty (the axis follows its ramp exactly, the default), a preset name
-  // or a motor description file (sim/motor_description.h, docs/tmcm-1636-servo.md).
+  // or a motor description file (sim/modules/tmcm1636/motor_description.h, docs/tmcm-1636-servo.md).
   std::string motor;
   // CANopen node ID as address switches would set it (`--node-id`, 1..127); 0: the stored one.
   uint8_t node_id = 0;

@@ -14,7 +14,7 @@
 #include "board/can_controller.h"
 #include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 #include "support/tmcm3216_board_rig.h"
 
 namespace motwin::modules::tmcm3216 {

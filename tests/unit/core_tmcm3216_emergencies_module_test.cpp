@@ -15,8 +15,8 @@
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "host/can_bus.h"
 #include "host/module_registry.h"
-#include "host/tmcm3216_virtual_module.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 #include "support/tmcm3216_board_rig.h"
 
 namespace motwin::modules::tmcm3216 {

@@ -9,7 +9,7 @@
 #include "host/can_bus.h"
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
-#include "host/tmcm3216_virtual_module.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 
 namespace motwin::host {
 namespace {

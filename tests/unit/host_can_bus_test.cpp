@@ -12,7 +12,7 @@
 #include "host/slcan_protocol.h"
 #include "host/socketcand_protocol.h"
 #include "host/socketcand_server.h"
-#include "host/tmcm3216_virtual_module.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 #include "support/host_test_support.h"
 
 namespace motwin::host {

@@ -8,7 +8,7 @@
 #include "core/tmcl/serial_link.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
-#include "host/tmcm1636_virtual_module.h"
+#include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
 #include "sim/scenario.h"
 #include "support/host_test_support.h"
 

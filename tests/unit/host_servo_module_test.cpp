@@ -11,7 +11,7 @@
 
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
-#include "host/tmcm1636_virtual_module.h"
+#include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
 #include "sim/scenario.h"
 #include "support/host_test_support.h"
 

@@ -12,7 +12,7 @@
 
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
-#include "host/tmcm142_virtual_module.h"
+#include "host/modules/tmcm142/tmcm142_virtual_module.h"
 #include "sim/scenario.h"
 #include "sim/stepper_motor_selection.h"
 

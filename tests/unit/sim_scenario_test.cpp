@@ -6,7 +6,7 @@
 #include <string>
 
 #include "sim/scenario.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 #include "support/host_test_support.h"
 
 namespace motwin::sim {

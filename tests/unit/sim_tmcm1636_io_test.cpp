@@ -5,7 +5,7 @@
 
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
 #include "sim/signals.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 namespace motwin::sim {
 namespace {

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <string>
 
-#include "board/tmcm1636_power_stage.h"
+#include "board/modules/tmcm1636/tmcm1636_power_stage.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
-#include "sim/motor_description.h"
-#include "sim/tmcm1636_plant.h"
-#include "sim/tmcm1636_sim_board.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/motor_description.h"
+#include "sim/modules/tmcm1636/tmcm1636_plant.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 namespace motwin::sim {
 namespace {

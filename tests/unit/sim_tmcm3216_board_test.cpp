@@ -1,4 +1,4 @@
-// The simulated TMCM-3216 board (sim/tmcm3216_sim_board.h) driven by the core's stepper axes:
+// The simulated TMCM-3216 board (sim/modules/tmcm3216/tmcm3216_sim_board.h) driven by the core's stepper axes:
 // motion of the ideal and the physical motors, switch windows, encoder and index polarity, a
 // blocked axis losing steps with StallGuard falling, driver faults, brake, I/O and signals.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
 #include "sim/scenario.h"
 #include "sim/stepper_plant.h"
-#include "sim/tmcm3216_sim_board.h"
-#include "host/tmcm3216_virtual_module.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 
 namespace motwin::sim {
 namespace {

@@ -13,11 +13,11 @@
 #include <vector>
 
 #include "core/modules/tmcm3216/tmcm3216.h"
-#include "host/tmcm3216_virtual_module.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 #include "sim/scenario.h"
 #include "sim/stepper_motor_selection.h"
 #include "sim/stepper_plant.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 #include "support/tmcm3216_board_rig.h"
 
 namespace motwin::sim {

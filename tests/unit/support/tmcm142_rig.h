@@ -8,7 +8,7 @@
 
 #include "board/ram_non_volatile_memory.h"
 #include "board/stepper_drive.h"
-#include "board/tmcm142_io.h"
+#include "board/modules/tmcm142/tmcm142_io.h"
 #include "core/modules/tmcm142/tmcm142.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"

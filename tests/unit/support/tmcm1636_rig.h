@@ -6,7 +6,7 @@
 #include <initializer_list>
 
 #include "board/ram_non_volatile_memory.h"
-#include "board/tmcm1636_io.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"

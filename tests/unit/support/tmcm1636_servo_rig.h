@@ -10,9 +10,9 @@
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
-#include "sim/motor_description.h"
-#include "sim/tmcm1636_sim_board.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/motor_description.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 namespace motwin::testing {
 

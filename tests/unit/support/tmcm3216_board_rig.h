@@ -1,4 +1,4 @@
-// A TMCM-3216 module on its simulated board (sim/tmcm3216_sim_board.h) and a RAM NVM, with a CAN
+// A TMCM-3216 module on its simulated board (sim/modules/tmcm3216/tmcm3216_sim_board.h) and a RAM NVM, with a CAN
 // controller that records what the module transmits and reports the fault confinement a test
 // sets: what the TMCM-3216 drive and module emergency tests drive through the dictionary.
 #pragma once
@@ -11,7 +11,7 @@
 #include "board/ram_non_volatile_memory.h"
 #include "core/can/can_frame.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 namespace motwin::testing {
 

@@ -11,7 +11,7 @@
 
 #include "board/non_volatile_memory.h"
 #include "board/stepper_drive.h"
-#include "board/tmcm142_io.h"
+#include "board/modules/tmcm142/tmcm142_io.h"
 #include "core/modules/tmcm142/tmcm142_axis.h"
 #include "core/modules/tmcm142/tmcm142_hardware.h"
 #include "core/params/parameter_table.h"

@@ -8,7 +8,7 @@
 #include <string_view>
 
 #include "board/non_volatile_memory.h"
-#include "board/tmcm1636_io.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
 #include "core/modules/tmcm1636/tmcm1636_axis.h"
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
 #include "core/params/parameter_table.h"

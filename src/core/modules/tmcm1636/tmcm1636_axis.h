@@ -2,7 +2,7 @@
 // and its motion. Two motors:
 //  - the *ideal* motor (no power stage attached): the axis follows the ramp generator exactly,
 //    the fast option (docs/tmcm-1636.md);
-//  - a real motor behind the power-stage seam (board/tmcm1636_power_stage.h): the cascaded
+//  - a real motor behind the power-stage seam (board/modules/tmcm1636/tmcm1636_power_stage.h): the cascaded
 //    regulators of manual chapter 5 (FOC current/flux PI, velocity PI, position P), commutation
 //    (open loop, digital hall, ABN encoder, absolute encoder), encoder initialisation, brake,
 //    brake chopper and protections, reading only ADC counts, hall levels and encoder counts and
@@ -11,8 +11,8 @@
 
 #include <cstdint>
 
-#include "board/tmcm1636_io.h"
-#include "board/tmcm1636_power_stage.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
+#include "board/modules/tmcm1636/tmcm1636_power_stage.h"
 #include "core/motion/hall_decoder.h"
 #include "core/motion/pi_regulator.h"
 #include "core/motion/position_pll.h"

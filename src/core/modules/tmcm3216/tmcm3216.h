@@ -4,7 +4,7 @@
 // memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour, RPDOs and
 // TPDOs with the manual's numbering and defaults, SYNC (consumer; producer as a Motwin extension)
 // and the LSS slave; and the three-axis CiA-402 drive (cia402::AxisDrive per axis) on the
-// stepper axes of its board (Tmcm3216Stepper, board/tmcm3216_board.h). docs/tmcm-3216-drive.md.
+// stepper axes of its board (Tmcm3216Stepper, board/modules/tmcm3216/tmcm3216_board.h). docs/tmcm-3216-drive.md.
 #pragma once
 
 #include <array>
@@ -15,7 +15,7 @@
 
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
-#include "board/tmcm3216_board.h"
+#include "board/modules/tmcm3216/tmcm3216_board.h"
 #include "core/can/can_frame.h"
 #include "core/cia402/axis_drive.h"
 #include "core/canopen/emergency.h"

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "board/tmcm3216_board.h"
+#include "board/modules/tmcm3216/tmcm3216_board.h"
 
 namespace motwin::modules::tmcm3216 {
 

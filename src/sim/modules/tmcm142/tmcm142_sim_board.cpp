@@ -1,4 +1,4 @@
-#include "sim/tmcm142_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_board.h"
 
 namespace motwin::sim {
 namespace {

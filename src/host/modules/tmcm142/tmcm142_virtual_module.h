@@ -8,8 +8,8 @@
 #include "core/modules/tmcm142/tmcm142.h"
 #include "host/module_registry.h"
 #include "host/tmcl_sim_module.h"
-#include "sim/tmcm142_sim_board.h"
-#include "sim/tmcm142_sim_io.h"
+#include "sim/modules/tmcm142/tmcm142_sim_board.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
 
 namespace motwin::host {
 

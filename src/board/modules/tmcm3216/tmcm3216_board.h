@@ -3,7 +3,7 @@
 // DIO pins that are inputs or outputs per 2711, two 12-bit analog inputs, and the supply voltage.
 // Plain data read and written once per tick, like the registers of the real board's peripherals.
 //
-// The simulated board (sim/tmcm3216_sim_board.h) fills every `feedback` and the input fields of
+// The simulated board (sim/modules/tmcm3216/tmcm3216_sim_board.h) fills every `feedback` and the input fields of
 // `io` before each tick and applies every `drive` and the output fields of `io` after it.
 #pragma once
 

@@ -1,4 +1,4 @@
-#include "host/tmcm142_virtual_module.h"
+#include "host/modules/tmcm142/tmcm142_virtual_module.h"
 
 #include "sim/stepper_motor_selection.h"
 

@@ -1,4 +1,4 @@
-#include "sim/tmcm142_sim_io.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
 
 #include <cmath>
 #include <string_view>

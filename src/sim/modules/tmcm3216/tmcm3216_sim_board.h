@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "board/tmcm3216_board.h"
+#include "board/modules/tmcm3216/tmcm3216_board.h"
 #include "sim/signals.h"
 #include "sim/stallguard_model.h"
 #include "sim/stepper_plant.h"

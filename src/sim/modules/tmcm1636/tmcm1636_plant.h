@@ -13,8 +13,8 @@
 
 #include <cstdint>
 
-#include "board/tmcm1636_power_stage.h"
-#include "sim/motor_description.h"
+#include "board/modules/tmcm1636/tmcm1636_power_stage.h"
+#include "sim/modules/tmcm1636/motor_description.h"
 
 namespace motwin::sim {
 

@@ -1,4 +1,4 @@
-#include "sim/tmcm1636_plant.h"
+#include "sim/modules/tmcm1636/tmcm1636_plant.h"
 
 #include <cmath>
 

@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "board/tmcm1636_io.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
 #include "sim/signals.h"
 
 namespace motwin::sim {
@@ -42,7 +42,7 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public LoggingSignalBoard 
   void set_reference_switch_level(board::ReferenceSwitch which, bool level);
   // With a physical motor the board measures its own bus and heat sink: ADC_VM and ADC_TEMP
   // then read these, while VSUPPLY and TEMP stay the source voltage and the ambient
-  // temperature that the signals set (sim/tmcm1636_sim_board.h).
+  // temperature that the signals set (sim/modules/tmcm1636/tmcm1636_sim_board.h).
   void set_measured_supply_raw(uint16_t raw) { supply_raw_ = raw; }
   void set_measured_temperature_celsius(double celsius);
 

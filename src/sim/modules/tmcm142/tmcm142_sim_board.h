@@ -19,7 +19,7 @@
 #include "sim/signals.h"
 #include "sim/stepper_plant.h"
 #include "sim/stepper_switch_sources.h"
-#include "sim/tmcm142_sim_io.h"
+#include "sim/modules/tmcm142/tmcm142_sim_io.h"
 
 namespace motwin::sim {
 

@@ -1,4 +1,4 @@
-#include "sim/motor_description.h"
+#include "sim/modules/tmcm1636/motor_description.h"
 
 #include <algorithm>
 #include <cmath>

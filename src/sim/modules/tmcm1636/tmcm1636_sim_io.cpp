@@ -1,4 +1,4 @@
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 #include <cmath>
 #include <string_view>

@@ -12,11 +12,11 @@
 #include <string_view>
 #include <vector>
 
-#include "board/tmcm1636_power_stage.h"
-#include "sim/motor_description.h"
+#include "board/modules/tmcm1636/tmcm1636_power_stage.h"
+#include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/signals.h"
-#include "sim/tmcm1636_plant.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_plant.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 namespace motwin::sim {
 

@@ -1,6 +1,6 @@
 // The TMCM-3216 (CANopen firmware V1.04) as a virtual module: the module profile with its CAN
 // controller on a virtual bus (host/can_bus.h), its NVM image in a file or in memory, and the
-// simulated board (sim/tmcm3216_sim_board.h: three steppers, their sensors, the I/O). Each tick:
+// simulated board (sim/modules/tmcm3216/tmcm3216_sim_board.h: three steppers, their sensors, the I/O). Each tick:
 // the board senses, the firmware ticks, the motors advance by Device's tick. It has no TMCL
 // interface.
 #pragma once
@@ -15,7 +15,7 @@
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
 #include "sim/signals.h"
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 namespace motwin::host {
 

@@ -5,8 +5,8 @@
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "host/module_registry.h"
 #include "host/tmcl_sim_module.h"
-#include "sim/tmcm1636_sim_board.h"
-#include "sim/tmcm1636_sim_io.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
 
 namespace motwin::host {
 

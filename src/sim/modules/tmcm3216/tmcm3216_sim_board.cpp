@@ -1,4 +1,4 @@
-#include "sim/tmcm3216_sim_board.h"
+#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 #include <cmath>
 #include <iterator>

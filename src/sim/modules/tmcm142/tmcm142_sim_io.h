@@ -1,7 +1,7 @@
 // Simulated general I/O of the TMCM-142 (connector 3, manual table 5.2): digital inputs IN0..IN8,
 // the analog inputs IN0..IN2 A/D (12 bit), the outputs OUT_0..OUT_2 and the motor supply. The
 // host sets inputs by name (--set, scenario files) and logs output changes. The limit switches
-// and the encoder belong to the motor side (sim/tmcm142_sim_board.h).
+// and the encoder belong to the motor side (sim/modules/tmcm142/tmcm142_sim_board.h).
 #pragma once
 
 #include <array>
@@ -10,7 +10,7 @@
 #include <span>
 #include <vector>
 
-#include "board/tmcm142_io.h"
+#include "board/modules/tmcm142/tmcm142_io.h"
 #include "sim/signals.h"
 
 namespace motwin::sim {

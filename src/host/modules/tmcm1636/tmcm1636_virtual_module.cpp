@@ -1,4 +1,4 @@
-#include "host/tmcm1636_virtual_module.h"
+#include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
 
 namespace motwin::host {
 

@@ -1,4 +1,4 @@
-#include "host/tmcm3216_virtual_module.h"
+#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 
 #include <cstdlib>
 

@@ -1,4 +1,4 @@
-#include "sim/tmcm1636_sim_board.h"
+#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
 
 #include <cmath>
 
