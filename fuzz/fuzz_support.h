@@ -12,10 +12,10 @@
 #include "board/can_controller.h"
 #include "board/ram_non_volatile_memory.h"
 #include "board/modules/tmcm1636/tmcm1636_io.h"
-#include "core/can/can_frame.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "core/tmcl/engine.h"
+#include "types/can_frame.h"
 
 // An invariant violation is a crash for libFuzzer: it saves the input as crash-<sha1>.
 #define FUZZ_CHECK(condition, ...)                                                                  \

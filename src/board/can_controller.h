@@ -7,7 +7,7 @@
 
 #include <cstdint>
 
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::board {
 

@@ -6,7 +6,7 @@
 
 #include <cstdint>
 
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

@@ -10,8 +10,8 @@
 #include <memory>
 #include <string>
 
-#include "core/can/can_frame.h"
 #include "host/can_bus.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

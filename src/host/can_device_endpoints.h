@@ -14,12 +14,12 @@
 #include <string>
 #include <vector>
 
-#include "core/can/can_frame.h"
 #include "host/can_bus.h"
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
 #include "host/pty_device.h"
 #include "host/slcan_protocol.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

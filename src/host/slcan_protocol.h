@@ -16,7 +16,7 @@
 #include <string>
 #include <string_view>
 
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

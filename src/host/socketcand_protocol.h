@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

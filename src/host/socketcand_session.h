@@ -21,8 +21,8 @@
 #include <string_view>
 #include <vector>
 
-#include "core/can/can_frame.h"
 #include "host/socketcand_protocol.h"
+#include "types/can_frame.h"
 
 namespace motwin::host {
 

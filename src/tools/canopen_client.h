@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::tools {
 

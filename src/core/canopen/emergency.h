@@ -10,7 +10,7 @@
 #include <cstdint>
 
 #include "board/can_controller.h"
-#include "core/can/can_frame.h"
+#include "types/can_frame.h"
 
 namespace motwin::canopen {
 

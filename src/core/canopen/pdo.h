@@ -27,8 +27,8 @@
 #include <span>
 
 #include "board/can_controller.h"
-#include "core/can/can_frame.h"
 #include "core/canopen/object_dictionary.h"
+#include "types/can_frame.h"
 
 namespace motwin::canopen {
 

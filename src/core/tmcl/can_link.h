@@ -9,8 +9,8 @@
 
 #include <cstdint>
 
-#include "core/can/can_frame.h"
 #include "core/tmcl/engine.h"
+#include "types/can_frame.h"
 
 namespace motwin::tmcl {
 

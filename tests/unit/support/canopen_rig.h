@@ -13,8 +13,8 @@
 #include "board/can_controller.h"
 #include "sdo_frames.h"
 #include "board/ram_non_volatile_memory.h"
-#include "core/can/can_frame.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
+#include "types/can_frame.h"
 
 namespace motwin::testing {
 

@@ -9,9 +9,9 @@
 #include <vector>
 
 #include "board/can_controller.h"
-#include "core/can/can_frame.h"
 #include "core/canopen/object_dictionary.h"
 #include "core/canopen/sdo_server.h"
+#include "types/can_frame.h"
 
 namespace motwin::testing {
 

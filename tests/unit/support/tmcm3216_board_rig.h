@@ -9,9 +9,9 @@
 
 #include "board/can_controller.h"
 #include "board/ram_non_volatile_memory.h"
-#include "core/can/can_frame.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
+#include "types/can_frame.h"
 
 namespace motwin::testing {
 

@@ -16,7 +16,6 @@
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
 #include "board/modules/tmcm3216/tmcm3216_board.h"
-#include "core/can/can_frame.h"
 #include "core/cia402/axis_drive.h"
 #include "core/canopen/emergency.h"
 #include "core/modules/tmcm3216/tmcm3216_emergencies.h"
@@ -30,6 +29,7 @@
 #include "core/canopen/sync.h"
 #include "core/modules/tmcm3216/tmcm3216_io.h"
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
+#include "types/can_frame.h"
 
 namespace motwin::modules::tmcm3216 {
 

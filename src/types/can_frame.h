@@ -1,6 +1,10 @@
 // One classic CAN frame as the controller sees it: identifier (11 or 29 bits), remote request
 // flag, data length code 0..8 and up to 8 data bytes. Plain data, no behaviour: the CANopen
 // services, the virtual bus and the transports all pass this type around.
+//
+// A leaf header of src/types/: vocabulary that every layer may use (the board seam's CAN
+// controller and the core's services alike), so it includes only the C++ standard library
+// (docs/architecture.md, "Include directions").
 #pragma once
 
 #include <cstdint>
