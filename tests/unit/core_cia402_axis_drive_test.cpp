@@ -6,10 +6,18 @@
 #include <cmath>
 
 #include "core/cia402/axis_drive.h"
+#include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "support/cia402_axis_rig.h"
 
 namespace motwin::cia402 {
 namespace {
+
+// The TMCM-3216's codes (table 365) and statusword bits 14/15, which its part gives the drive.
+using modules::tmcm3216::kEmcyFaultReset;
+using modules::tmcm3216::kEmcyFollowingError;
+using modules::tmcm3216::kEmcyLimit;
+using modules::tmcm3216::kSwMotorActivity;
+constexpr uint16_t kEmcyStall = modules::tmcm3216::kEmcyStallGuard;
 
 constexpr uint32_t kTickUs = testing::Cia402AxisRig::kTickUs;
 
@@ -331,7 +339,7 @@ TEST(Cia402AxisDrive, HomingSpeedsAndAccelerationBeyondInt32Saturate) {
 
   // The same through 6083 (609A = 0) in internal units (208E), where 2^32 - 1 scales to ~3e11 pps/s.
   Axis b;
-  b.drive.objects.velocity_dimension = 0;
+  b.drive.manufacturer.velocity_dimension = 0;
   b.drive.objects.homing_method = 19;
   b.drive.objects.homing_speed_fast = 50000;
   b.drive.objects.homing_speed_slow = 10000;
@@ -386,7 +394,7 @@ TEST(Cia402AxisDrive, CyclicSyncVelocityReachesSetPointWithinOnePeriod) {
 
 TEST(Cia402AxisDrive, InternalUnitsScaleVelocities) {
   Axis a;
-  a.drive.objects.velocity_dimension = 0;
+  a.drive.manufacturer.velocity_dimension = 0;
   const UnitScale u = a.drive.units();
   EXPECT_NEAR(u.velocity_pps(1 << 24), 12e6, 1e-6);
   EXPECT_NEAR(u.acceleration_pps2(1), 12e6 * 12e6 / std::pow(2.0, 41), 1e-9);

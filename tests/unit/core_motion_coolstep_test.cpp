@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "core/motion/coolstep.h"
+#include "core/modules/tmcm3216/tmcm3216_stepper.h"
 #include "core/motion/stall_detector.h"
 
 namespace motwin::motion {
@@ -218,12 +219,13 @@ TEST(StallDetector, stallguard4_below_its_threshold_in_stealthchop) {
 }
 
 TEST(StallDetector, option_code_20A7) {
+  using modules::tmcm3216::stall_reaction_of;  // the module decodes its object
   StallReaction reaction = StallReaction::kStop;
-  EXPECT_TRUE(StallDetectorConfig::reaction_of(0, reaction));
+  EXPECT_TRUE(stall_reaction_of(0, reaction));
   EXPECT_EQ(reaction, StallReaction::kFault);
-  EXPECT_TRUE(StallDetectorConfig::reaction_of(1, reaction));
+  EXPECT_TRUE(stall_reaction_of(1, reaction));
   EXPECT_EQ(reaction, StallReaction::kStop);
-  EXPECT_FALSE(StallDetectorConfig::reaction_of(2, reaction));
+  EXPECT_FALSE(stall_reaction_of(2, reaction));
   EXPECT_EQ(reaction, StallReaction::kStop);  // untouched
   EXPECT_EQ(StallDetectorConfig{}.reaction, StallReaction::kFault);  // default 0
 }

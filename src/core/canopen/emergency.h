@@ -1,7 +1,8 @@
 // EMCY producer (CiA-301 7.2.7, TMCM-3216 manual chapter 11), in the shape of CANopenNode's
 // CO_Emergency: report() queues an emergency, process() sends it, never two closer together than
 // the inhibit time 1015 (100 µs units). A message is always 8 bytes: error code (little-endian),
-// error register 1001, five manufacturer bytes (byte 2 = the motor, 255 = none: table 365).
+// error register 1001, five manufacturer-specific bytes that the module fills (the TMCM-3216
+// puts the motor in byte 2).
 // COB-ID 1014 with bit 31 set switches the producer off (reports are dropped).
 #pragma once
 
@@ -14,15 +15,21 @@
 
 namespace motwin::canopen {
 
-// Error codes of table 365 that the communication part produces.
+// Error codes of CiA-301 (table 21) for the communication part.
 inline constexpr uint16_t kEmcyErrorReset = 0x0000;
-inline constexpr uint16_t kEmcyHeartbeat = 0x8130;
 inline constexpr uint16_t kEmcyCanOverflow = 0x8110;
-inline constexpr uint16_t kEmcyPdoParameter = 0x6320;  // RPDO value refused (manual table 365)
+inline constexpr uint16_t kEmcyCanErrorPassive = 0x8120;
+inline constexpr uint16_t kEmcyHeartbeat = 0x8130;
+inline constexpr uint16_t kEmcyCanBusOffRecovered = 0x8140;
 
-// 1001 bits (table 11).
+// 1001 bits (CiA-301 table 47).
 inline constexpr uint8_t kErrorRegisterGeneric = 0x01;
+inline constexpr uint8_t kErrorRegisterCurrent = 0x02;
+inline constexpr uint8_t kErrorRegisterVoltage = 0x04;
+inline constexpr uint8_t kErrorRegisterTemperature = 0x08;
 inline constexpr uint8_t kErrorRegisterCommunication = 0x10;
+inline constexpr uint8_t kErrorRegisterDeviceProfile = 0x20;
+inline constexpr uint8_t kErrorRegisterManufacturer = 0x80;
 
 class EmergencyProducer {
  public:

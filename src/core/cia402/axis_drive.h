@@ -1,19 +1,37 @@
-// One CiA-402 axis of the TMCM-3216: the PDS state machine (power_drive_system.h), the modes of
-// operation and their dispatch (pp, pv, hm, csp, csv; 6060/6061), the EightPoint ramp that
-// produces the position demand (6062), the monitoring functions (position window, following
-// error, software limits, limit switches, stall) and the statusword. It is pure arithmetic: the
-// module hands in what the axis hardware saw this tick (AxisInputs) and passes the demand on to
-// the stepper (AxisDemand); emergencies are queued for the module to send with the axis number.
+// One CiA-402 axis: the PDS state machine (power_drive_system.h), the modes of operation and
+// their dispatch (pp, pv, hm, csp, csv; 6060/6061), the EightPoint ramp that produces the
+// position demand (6062), the monitoring functions (position window, following error, software
+// limits, limit switches, stall, power-stage faults) and the statusword. It is pure arithmetic:
+// the module hands in what the axis hardware saw this tick (AxisInputs) and passes the demand on
+// to its stepper (AxisDemand); drive events (fault reset, following error, stall, limits) are
+// queued as emergencies for the module to read.
 //
 // Edges of the controlword (pp new set-point, hm start, fault reset) act when the controlword
 // is written, so that a statusword read right after the write already shows the
-// acknowledgement (python-canopen and ros2_canopen poll at once, notes/canopen.md).
+// acknowledgement (python-canopen and ros2_canopen poll at once, docs/tmcm-3216-drive.md).
 //
 // Internal units: microsteps, microsteps/s (pps), microsteps/s² (pps2); objects are converted
-// with UnitScale (208C/208E). See docs/tmcm-3216-drive.md for the behaviour in detail.
+// with the module's UnitScale. docs/tmcm-3216-drive.md describes the behaviour in detail.
+//
+// The module's part (a compile-time seam, as moteus plugs its board into the controller):
+// AxisDrive<Manufacturer> keeps one `Manufacturer` per axis (`manufacturer`: the module's
+// manufacturer-specific objects that shape the drive) and calls it directly, so the calls inline
+// on the per-tick path. It provides (concept ManufacturerPart):
+//   UnitScale units() const
+//       what one unit of the velocity and acceleration objects is internally;
+//   void shape_profile(motion::EightPointConfig& profile, const UnitScale& units) const
+//       the module's additions to the profile of pp and pv, which the profile objects make a
+//       plain trapezoid (6081 VMAX, 6083 AMAX, 6084 DMAX, 6082 VSTOP);
+//   static AxisEmergency emergency(DriveEvent event)
+//       the EMCY code and additional byte the module reports a drive event with;
+//   static uint16_t manufacturer_status_bits(bool motor_active, bool negative_direction)
+//       the manufacturer-specific statusword bits (8, 14, 15).
+// The member definitions are in axis_drive_impl.h, compiled once per module where the module
+// instantiates its drive (the TMCM-3216: src/core/modules/tmcm3216/tmcm3216_drive.{h,cpp}).
 #pragma once
 
 #include <array>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 
@@ -24,46 +42,47 @@
 
 namespace motwin::cia402 {
 
-// EMCY codes the drive produces (manual table 365); additional byte 1 is `sub`.
-inline constexpr uint16_t kEmcyFaultReset = 0x0000;
-inline constexpr uint16_t kEmcyOpenLoad = 0x1000;          // sub 1 bridge A, 2 bridge B
-inline constexpr uint16_t kEmcyOvercurrentHighSide = 0x2310;
-inline constexpr uint16_t kEmcyOvercurrentB = 0x2311;
-inline constexpr uint16_t kEmcyOvercurrentA = 0x2312;
-inline constexpr uint16_t kEmcyStall = 0x3230;
-inline constexpr uint16_t kEmcyOvertemperature = 0x4310;  // sub 0 error, 1 pre-warning
-inline constexpr uint16_t kEmcyFollowingError = 0x8611;
-inline constexpr uint16_t kEmcyUndervoltage = 0xFF00;
-inline constexpr uint16_t kEmcyLimit = 0xFF01;  // sub 1/2 positive/negative software limit, 3/4 switch
-
-// Driver error bits as the stepper reports them (board::kDriver*, 2102).
-inline constexpr uint8_t kDriverOvercurrentA = 1u << 0;
-inline constexpr uint8_t kDriverOvercurrentB = 1u << 1;
-inline constexpr uint8_t kDriverOpenLoadA = 1u << 2;
-inline constexpr uint8_t kDriverOpenLoadB = 1u << 3;
-inline constexpr uint8_t kDriverOvercurrentHighSide = 1u << 4;
-inline constexpr uint8_t kDriverUndervoltage = 1u << 5;
-inline constexpr uint8_t kDriverTemperatureWarning = 1u << 6;
-inline constexpr uint8_t kDriverOvertemperature = 1u << 7;
+// What the drive reports (take_emergency()), in CiA-402 terms; the module's part gives each its
+// EMCY code and additional byte.
+enum class DriveEvent : uint8_t {
+  kFaultReset,             // transition 15 carried out
+  kFollowingError,         // 6065 exceeded (606A = 0)
+  kStall,                  // the stall input rose
+  kSoftwareLimitPositive,  // the axis ran onto 607D sub 2 (corrected by 607C)
+  kSoftwareLimitNegative,  // ... onto 607D sub 1
+  kLimitSwitchPositive,    // ... onto the positive (right) limit switch
+  kLimitSwitchNegative,    // ... onto the negative (left) limit switch
+};
 
 struct AxisEmergency {
   uint16_t code = 0;
   uint8_t sub = 0;  // additional byte 1
 };
 
+template <class M>
+concept ManufacturerPart = requires(const M& part, motion::EightPointConfig& profile, const UnitScale& units,
+                                    DriveEvent event, bool flag) {
+  { part.units() } -> std::same_as<UnitScale>;
+  part.shape_profile(profile, units);
+  { M::emergency(event) } -> std::same_as<AxisEmergency>;
+  { M::manufacturer_status_bits(flag, flag) } -> std::same_as<uint16_t>;
+};
+
 // What the axis hardware shows this tick.
 struct AxisInputs {
   int32_t encoder_position_usteps = 0;  // scaled to microsteps (608F); used when 606A = 0
-  bool left_limit = false;              // processed levels (2005 disable/invert applied)
+  bool left_limit = false;              // processed levels (the module applied disable/invert)
   bool right_limit = false;
   bool home_switch = false;
   uint32_t index_events = 0;
   int32_t index_position_usteps = 0;
   bool index_available = false;
-  bool stall = false;               // the stepper's stall detection (20A4 / 20A8)
-  bool stall_enters_fault = true;   // 20A7 = 0: FAULT; 1: stop only
-  uint8_t driver_errors = 0;        // kDriver* bits
-  // The power stage is on and the brake open (200A, 2002 sub 2 passed): motion may start.
+  bool stall = false;               // the stepper's stall detection
+  bool stall_enters_fault = true;   // the module's stall reaction: FAULT, or only a stop
+  // The power stage reports a fault that keeps the motor from running (the module decides which
+  // of its driver's flags do): FAULT while the power stage is on.
+  bool power_stage_fault = false;
+  // The power stage is on and the brake open (the module's delays passed): motion may start.
   bool ready = true;
 };
 
@@ -77,18 +96,20 @@ struct AxisDemand {
   bool clear_stall = false;  // the stall was handled: detect the next one
 };
 
+template <class Manufacturer>
 class AxisDrive {
+  static_assert(ManufacturerPart<Manufacturer>, "see \"The module's part\" above");
+
  public:
-  static constexpr double kDefaultClockHz = 12e6;
   // csp/csv: a set-point written without a SYNC for this long is taken at once.
   static constexpr uint32_t kSyncAbsentUs = 100'000;
 
   ProfileObjects objects;
+  Manufacturer manufacturer{};
 
   // Power-up and NMT reset node: SWITCH ON DISABLED, standing at `position`, objects kept.
   void reset(int32_t position = 0);
-  void set_clock_hz(double clock_hz) { clock_hz_ = clock_hz; }
-  // Microsteps per motor revolution (2000 x 2001): index homing gives up after two revolutions.
+  // Microsteps per motor revolution: index homing gives up after two revolutions.
   void set_usteps_per_revolution(uint32_t usteps) { usteps_per_revolution_ = usteps; }
 
   // 6040 written (SDO or RPDO).
@@ -101,8 +122,8 @@ class AxisDrive {
   void on_sync();
   // A fault from outside the axis (NMT stopped while operation enabled, ...).
   void external_fault() { pds_.fault(); }
-  // The position counter takes `position` without motion (homing, 200B sub 3 position
-  // initialisation); the encoder position is re-based to it.
+  // The position counter takes `position` without motion (homing, or the module's encoder
+  // position initialisation); the encoder position is re-based to it.
   void assign_position(int32_t position);
 
   // One motion tick.
@@ -117,7 +138,7 @@ class AxisDrive {
   int8_t mode_display() const { return objects.mode; }  // 6061 follows 6060 at once
   int32_t position_demand() const { return ramp_.position(); }  // 6062
   int32_t position_actual() const;                               // 6063 / 6064
-  int32_t velocity_actual_value() const;                         // 606C in 208C units
+  int32_t velocity_actual_value() const;                         // 606C in object units
   double velocity_pps() const { return ramp_.velocity(); }
   PdsState state() const { return pds_.state(); }
   const PowerDriveSystem& pds() const { return pds_; }
@@ -126,8 +147,8 @@ class AxisDrive {
   bool target_reached() const { return target_reached_; }
   bool following_error() const { return following_error_; }
   bool limit_active() const { return limit_active_; }
-  UnitScale units() const { return UnitScale::of(objects.velocity_dimension, clock_hz_); }
-  // The profile of the present mode in internal units (pp: 6081..6085 with 2010..2018).
+  UnitScale units() const { return manufacturer.units(); }
+  // The profile of the present mode in internal units: 6081..6085, shaped by the module.
   motion::EightPointConfig profile_config() const;
   // Software limits corrected by the home offset (607D, manual 6.1.11); false when unlimited.
   bool min_limit(int64_t& limit) const;
@@ -135,7 +156,7 @@ class AxisDrive {
 
  private:
   PdsOptions options() const;
-  void emergency(uint16_t code, uint8_t sub = 0);
+  void emergency(DriveEvent event);
   void on_mode_change(int8_t from, int8_t to);
   void accept_set_point(uint16_t controlword);
   // 607A + the set-point's base, clamped to the software limits.
@@ -160,7 +181,6 @@ class AxisDrive {
   void update_target_reached(const AxisInputs& inputs, uint32_t dt_us);
   double interpolation_period_s() const;
 
-  double clock_hz_ = kDefaultClockHz;
   uint32_t usteps_per_revolution_ = 51200;
   PowerDriveSystem pds_;
   motion::EightPointRamp ramp_;
@@ -204,11 +224,10 @@ class AxisDrive {
   bool limit_negative_ = false;
   bool limit_reported_[4] = {};  // software +/-, switch +/-: EMCY once per excursion
   bool stall_latched_ = false;
-  bool stall_stop_ = false;  // stopped by a stall with 20A7 = 1 until a new command
+  bool stall_stop_ = false;  // stopped by a stall that does not fault, until a new command
   bool clear_stall_request_ = false;  // demand.clear_stall in the next tick
-  uint8_t previous_driver_errors_ = 0;
   int32_t actual_position_ = 0;
-  // The encoder keeps counting from its own zero: an assigned position (homing, 200B sub 3)
+  // The encoder keeps counting from its own zero: an assigned position (homing, initialisation)
   // re-bases it with this offset, so that 6064 and the following error stay in the demand's frame.
   int32_t last_encoder_usteps_ = 0;
   int32_t encoder_offset_ = 0;

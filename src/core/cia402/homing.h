@@ -1,4 +1,5 @@
-// CiA-402 homing of one axis, the methods of the TMCM-3216 manual (chapter 8.1, table 296):
+// CiA-402 homing of one axis, the methods this drive implements (CiA-402 part 2; the TMCM-3216
+// manual lists the same ones in chapter 8.1, table 296):
 //   0 no homing; 1/2 negative/positive limit switch then index; 3/5 home switch (active on its
 //   positive/negative side) then index; 17/18 negative/positive limit switch; 19/21 home switch
 //   edge; 33/34 next index pulse in negative/positive direction; 35 current position is home.
@@ -19,7 +20,7 @@
 
 namespace motwin::cia402 {
 
-// 6099, 609A, 607C in internal units (the drive converts with 208C/208E before start()).
+// 6099, 609A, 607C in internal units (the drive converts with its UnitScale before start()).
 struct HomingConfig {
   int32_t fast_speed_pps = 0;      // 6099 sub 1: search for the switch (> 0)
   int32_t slow_speed_pps = 0;      // 6099 sub 2: edge, index search, move to home (> 0)
@@ -32,7 +33,8 @@ struct HomingConfig {
   uint32_t search_limit_usteps = 0;
 };
 
-// What the axis shows this tick. Switches are the processed levels (after 2005 disable/invert):
+// What the axis shows this tick. Switches are the processed levels (the module applied its
+// disable/invert settings):
 // true = active.
 struct HomingInputs {
   int32_t position_usteps = 0;        // actual (demand) position counter
@@ -94,7 +96,7 @@ class Homing {
   // Every tick while the axis is in homing mode and operation is enabled (or any time for 35).
   HomingCommand step(const HomingInputs& inputs, uint32_t dt_us);
 
-  // For the statusword (notes/canopen.md): bit 12 = attained(), bit 13 = error(), bit 10 (target
+  // For the statusword (docs/tmcm-3216-drive.md): bit 12 = attained(), bit 13 = error(), bit 10 (target
   // reached) = !active() once started. reason() says why an error happened.
   State state() const { return state_; }
   bool active() const { return state_ == State::kActive; }

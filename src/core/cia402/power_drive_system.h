@@ -66,8 +66,8 @@ inline constexpr uint16_t kSwTargetReached = 1u << 10;
 inline constexpr uint16_t kSwInternalLimit = 1u << 11;
 inline constexpr uint16_t kSwOms12 = 1u << 12;  // set-point acknowledge / homing attained / target used
 inline constexpr uint16_t kSwOms13 = 1u << 13;  // following error / homing error
-inline constexpr uint16_t kSwMotorActivity = 1u << 14;  // Trinamic: the motor moves
-inline constexpr uint16_t kSwDirection = 1u << 15;      // Trinamic: direction of rotation (1 = negative)
+// Bits 8, 14 and 15 are manufacturer-specific: the module's part of the drive sets them
+// (axis_drive.h, manufacturer_status_bits()).
 
 // The state bits of the statusword (bits 0..3, 5, 6) per table 234; bit 4 (voltage enabled) is
 // set in the states where the controlword enabled the voltage.
@@ -104,7 +104,7 @@ class PowerDriveSystem {
 
   // A controlword written (SDO or RPDO). Returns true when it changed the state.
   bool on_controlword(uint16_t controlword, const PdsOptions& options);
-  // A fault detected by the axis (following error, stall with 20A7 = fault, NMT stopped, ...):
+  // A fault detected by the axis (following error, a stall that faults, NMT stopped, ...):
   // transition 13 from any state but FAULT. From states without power the drive goes straight
   // to FAULT (there is nothing to stop).
   void fault();

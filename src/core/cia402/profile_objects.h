@@ -1,8 +1,9 @@
-// The CiA-402 objects of one axis (TMCM-3216 manual chapters 5-10; axis n at index + n x 0x800)
-// and the EightPoint ramp objects of the manufacturer area (2010..2018, 208C; + n x 0x200), as
-// the values a master wrote, in the objects' own units. The drive converts them to internal units
-// (microsteps, microsteps/s, microsteps/s²) where it uses them, so that 208C applies to every
-// velocity and acceleration object at once.
+// The CiA-402 objects of one axis (6xxx; the TMCM-3216 manual's chapters 5-10 list the ones it
+// implements), as the values a master wrote, in the objects' own units. The drive converts them
+// to internal units (microsteps, microsteps/s, microsteps/s²) where it uses them, with the
+// UnitScale its module gives (axis_drive.h), so that a unit choice applies to every velocity and
+// acceleration object at once. A module's manufacturer objects are not here: they are the
+// module's part of the drive (axis_drive.h, "The module's part").
 #pragma once
 
 #include <cstdint>
@@ -25,13 +26,6 @@ constexpr bool supported_mode(int64_t value) {
 // 6502: bit 0 pp, 2 pv, 5 hm, 7 csp, 8 csv.
 inline constexpr uint32_t kSupportedDriveModes = (1u << 0) | (1u << 2) | (1u << 5) | (1u << 7) | (1u << 8);
 
-// 208C values.
-inline constexpr uint8_t kVelocityDimensionInternal = 0;
-inline constexpr uint8_t kVelocityDimensionPps = 181;
-// 208E values.
-inline constexpr uint8_t kAccelerationDimensionInternal = 0;
-inline constexpr uint8_t kAccelerationDimensionPps2 = 179;
-
 struct ProfileObjects {
   // Option codes 605A..605E.
   int16_t quick_stop_option = 2;
@@ -48,8 +42,8 @@ struct ProfileObjects {
   int32_t home_offset = 0;                          // 607C
   int32_t software_limit_min = std::numeric_limits<int32_t>::min();  // 607D sub 1
   int32_t software_limit_max = std::numeric_limits<int32_t>::max();  // 607D sub 2
-  // Velocities in 208C units, accelerations in 208E units. The manual's defaults of 6081, 6083
-  // and 6084 are 0, which would make its own examples (6.2, 7.2) stand still: see
+  // Velocities and accelerations in the object units (UnitScale). The manual's defaults of 6081,
+  // 6083 and 6084 are 0, which would make its own examples (6.2, 7.2) stand still: see
   // docs/tmcm-3216-drive.md "Decisions".
   uint32_t profile_velocity = 51200;                // 6081
   uint32_t end_velocity = 0;                        // 6082
@@ -67,28 +61,16 @@ struct ProfileObjects {
   uint8_t interpolation_period = 1;                 // 60C2 sub 1
   int8_t interpolation_index = -3;                  // 60C2 sub 2: period = sub1 x 10^sub2 s
   uint32_t encoder_increments = 1;                  // 608F sub 1 (per motor revolution)
-  // Manufacturer ramp objects (2010..2018, manual 4.2.10-4.2.17).
-  uint32_t start_velocity = 0;                      // 2010 VSTART
-  uint32_t a1 = 0;                                  // 2011
-  uint32_t v1 = 0;                                  // 2012
-  uint32_t d1 = 0;                                  // 2013
-  uint16_t ramp_wait_time = 0;                      // 2015, 32 µs units
-  uint32_t a2 = 0;                                  // 2016
-  uint32_t v2 = 0;                                  // 2017
-  uint32_t d2 = 0;                                  // 2018
-  uint8_t velocity_dimension = kVelocityDimensionPps;  // 208C
 };
 
-// Object units -> internal units. `clock_hz` is the driver chip's clock (TMC: v = v_reg x fCLK /
-// 2^24, a = a_reg x fCLK² / 2^41, motion-models.md).
+// Object units -> internal units: what one unit of a velocity object (6081, 60FF, 6099, ...) and
+// of an acceleration object (6083..6085, 609A) is in microsteps/s and microsteps/s². CiA-402
+// leaves the units to the drive; the module decides them (AxisDrive's module part, units()).
+// The default is 1:1.
 struct UnitScale {
   double pps_per_velocity_unit = 1.0;
   double pps2_per_acceleration_unit = 1.0;
 
-  static UnitScale of(uint8_t velocity_dimension, double clock_hz) {
-    if (velocity_dimension != kVelocityDimensionInternal) return UnitScale{};
-    return UnitScale{clock_hz / 16777216.0, clock_hz * clock_hz / 2199023255552.0};
-  }
   double velocity_pps(double value) const { return value * pps_per_velocity_unit; }
   double acceleration_pps2(double value) const { return value * pps2_per_acceleration_unit; }
   // Internal velocity -> object units (606C), rounded towards zero.

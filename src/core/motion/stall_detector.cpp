@@ -7,15 +7,9 @@ uint32_t magnitude(int32_t v) { return v < 0 ? 0u - static_cast<uint32_t>(v) : s
 
 }  // namespace
 
-bool StallDetectorConfig::reaction_of(uint8_t option_code, StallReaction& out) {
-  if (option_code > 1) return false;
-  out = option_code == 0 ? StallReaction::kFault : StallReaction::kStop;
-  return true;
-}
-
 bool StallDetector::step(const StallDetectorConfig& config, const StallDetectorInputs& inputs) {
   if (stalled_ || !inputs.new_measurement || config.stop_velocity_pps == 0) return false;
-  // "Below this speed the motor is not stopped. Above this speed ..." (20A4): strictly above.
+  // "Below this speed the motor is not stopped. Above this speed ..." (manual 4.2.37): strictly above.
   if (magnitude(inputs.velocity_pps) <= config.stop_velocity_pps) return false;
   const bool at_limit = inputs.stealth_chop
                             ? inputs.stallguard4_result < config.stallguard4_threshold

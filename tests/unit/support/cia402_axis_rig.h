@@ -1,4 +1,4 @@
-// One CiA-402 axis (core/cia402/axis_drive.h) without hardware, stepped in 50 µs ticks: what the
+// One CiA-402 axis (core/cia402/axis_drive.h, with the TMCM-3216's part: tmcm3216_drive.h) without hardware, stepped in 50 µs ticks: what the
 // axis drive and axis object tests drive. The encoder input follows the position demand, `lag`
 // µsteps behind (a motor behind its field).
 #pragma once
@@ -6,14 +6,14 @@
 #include <cmath>
 #include <cstdint>
 
-#include "core/cia402/axis_drive.h"
+#include "core/modules/tmcm3216/tmcm3216_drive.h"
 
 namespace motwin::testing {
 
 struct Cia402AxisRig {
   static constexpr uint32_t kTickUs = 50;
 
-  cia402::AxisDrive drive;
+  modules::tmcm3216::Tmcm3216Drive drive;
   cia402::AxisInputs inputs;
   // The encoder reads the demand minus this lag.
   int32_t encoder_lag = 0;

@@ -32,9 +32,7 @@ Tmcm3216::Tmcm3216(board::NonVolatileMemory& nvm, board::CanController& can, boa
       pdos_(dictionary_, can, communication_.rpdo, communication_.rpdo_mapping, communication_.tpdo,
             communication_.tpdo_mapping),
       lss_(can, *this),
-      storage_(dictionary_, nvm, storage_scratch_.data(), storage_scratch_.size()) {
-  for (cia402::AxisDrive& drive : drives_) drive.set_clock_hz(kDriverClockHz);
-}
+      storage_(dictionary_, nvm, storage_scratch_.data(), storage_scratch_.size()) {}
 
 canopen::LssIdentity Tmcm3216::identity() const {
   return canopen::LssIdentity{kVendorId, kProductCode, kRevisionNumber, config_.serial_number};
@@ -187,14 +185,14 @@ void Tmcm3216::check_can_controller() {
   // the axes, so each running one takes its fault reaction (605E ramp, then FAULT), as with
   // NMT stopped. Also when a bus-off began and ended between two polls.
   if (bus_off || recovered) {
-    for (cia402::AxisDrive& drive : drives_) {
+    for (Tmcm3216Drive& drive : drives_) {
       if (drive.pds().power_enabled()) drive.external_fault();
     }
   }
   if (recovered) {
     // Bus-on again: 8140 is the controller's first message (a bus-off node sends nothing).
     can_controller_error_ = CanControllerError::kRecovered;
-    report_error(kCommErrorCanController, kEmcyCanBusOffRecovered);
+    report_error(kCommErrorCanController, canopen::kEmcyCanBusOffRecovered);
     return;
   }
   switch (status.error_state) {
@@ -208,7 +206,7 @@ void Tmcm3216::check_can_controller() {
       // An error-passive node still transmits (with a longer pause): 8120 goes out now.
       if (can_controller_error_ != CanControllerError::kErrorPassive) {
         can_controller_error_ = CanControllerError::kErrorPassive;
-        report_error(kCommErrorCanController, kEmcyCanErrorPassive);
+        report_error(kCommErrorCanController, canopen::kEmcyCanErrorPassive);
       }
       return;
     case board::CanErrorState::kErrorActive:
@@ -249,7 +247,7 @@ void Tmcm3216::check_rpdo_values() {
   if (any_refused) {
     if (!parameter_error_) {
       parameter_error_ = true;
-      emergency_.report(canopen::kEmcyPdoParameter, error_register(), kNoMotor);
+      emergency_.report(kEmcyPdoParameter, error_register(), kNoMotor);
     }
   } else if (any_written && parameter_error_) {
     parameter_error_ = false;
@@ -403,11 +401,11 @@ void Tmcm3216::reset_axes() {
 }
 
 void Tmcm3216::sync_axes() {
-  for (cia402::AxisDrive& drive : drives_) drive.on_sync();
+  for (Tmcm3216Drive& drive : drives_) drive.on_sync();
 }
 
 uint8_t Tmcm3216::axis_error_register() const {
-  for (const cia402::AxisDrive& drive : drives_) {
+  for (const Tmcm3216Drive& drive : drives_) {
     const cia402::PdsState state = drive.state();
     if (state == cia402::PdsState::kFault || state == cia402::PdsState::kFaultReactionActive) {
       return kErrorRegisterAxisFault;  // generic + device profile (table 11)
@@ -423,7 +421,7 @@ void Tmcm3216::run_axes(uint32_t dt_us) {
   // it stays open.
   const uint8_t others = static_cast<uint8_t>(error_register_ | axis_error_register());
   if (emergencies_.update_shutdown(!board_.io.enable_input, emergency_, others).fault) {
-    for (cia402::AxisDrive& drive : drives_) drive.external_fault();
+    for (Tmcm3216Drive& drive : drives_) drive.external_fault();
   }
   bool brake_control[kAxisCount] = {};
   uint8_t brake_duty[kAxisCount] = {};
@@ -436,7 +434,7 @@ void Tmcm3216::run_axes(uint32_t dt_us) {
 }
 
 void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
-  cia402::AxisDrive& drive = drives_[axis];
+  Tmcm3216Drive& drive = drives_[axis];
   Tmcm3216Stepper& stepper = steppers_[axis];
   // NMT stopped takes the drive function away from a running axis: FAULT (issue 7).
   if (configured() && nmt_.state() == NmtState::kStopped && drive.state() == cia402::PdsState::kOperationEnabled) {
@@ -456,7 +454,7 @@ void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
   inputs.index_available = true;
   inputs.stall = stepper.stall_detected();
   inputs.stall_enters_fault = stepper.stall_enters_fault();
-  inputs.driver_errors = stepper.driver_error_flags();
+  inputs.power_stage_fault = (stepper.driver_error_flags() & kDriverFaultFlags) != 0;
   inputs.ready = stepper.ready();
   // Table 365 on the same readings and PDS state the drive sees in this step (after it, a
   // standing axis the drive has just faulted has its power stage off: a driver fault would pass
@@ -471,7 +469,7 @@ void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
   drive.set_usteps_per_revolution(stepper.microsteps_per_full_step() * stepper.objects.full_steps_per_revolution);
   // Profile objects the stepper needs (608F sub 1 is bound to the stepper directly).
   stepper.objects.encoder_used = drive.objects.sensor_selection == 0;
-  stepper.objects.velocity_in_chip_units = drive.objects.velocity_dimension == cia402::kVelocityDimensionInternal;
+  stepper.objects.velocity_in_chip_units = drive.manufacturer.velocity_dimension == kVelocityDimensionInternal;
   StepperDemand stepper_demand;
   stepper_demand.position_usteps = demand.position_usteps;
   stepper_demand.velocity_pps = demand.velocity_pps;
@@ -485,7 +483,7 @@ void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
   // the EMCY of a fault still present, and then the axis goes back to FAULT.
   cia402::AxisEmergency emcy;
   while (drive.take_emergency(emcy)) {
-    if (emcy.code != cia402::kEmcyFaultReset) continue;
+    if (emcy.code != kEmcyFaultReset) continue;
     const uint8_t now_others = static_cast<uint8_t>(error_register_ | axis_error_register());
     if (!emergencies_.fault_reset(axis, emergency_, now_others)) drive.external_fault();
   }

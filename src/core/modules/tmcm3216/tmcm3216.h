@@ -3,7 +3,7 @@
 // boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
 // memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour, RPDOs and
 // TPDOs with the manual's numbering and defaults, SYNC (consumer; producer as a Motwin extension)
-// and the LSS slave; and the three-axis CiA-402 drive (cia402::AxisDrive per axis) on the
+// and the LSS slave; and the three-axis CiA-402 drive (Tmcm3216Drive per axis) on the
 // stepper axes of its board (Tmcm3216Stepper, board/modules/tmcm3216/tmcm3216_board.h). docs/tmcm-3216-drive.md.
 #pragma once
 
@@ -16,8 +16,8 @@
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
 #include "board/modules/tmcm3216/tmcm3216_board.h"
-#include "core/cia402/axis_drive.h"
 #include "core/canopen/emergency.h"
+#include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "core/modules/tmcm3216/tmcm3216_emergencies.h"
 #include "core/canopen/heartbeat_consumer.h"
 #include "core/canopen/nmt.h"
@@ -44,10 +44,6 @@ inline constexpr size_t kPdoCount = kAxisCount * kPdosPerAxis;  // per direction
 // SDO request is answered within the tick or process() call that sees it).
 inline constexpr uint32_t kTickUs = 50;
 inline constexpr uint32_t kServicePeriodUs = 1000;
-
-// EMCY codes of the CAN controller (table 365; additional byte 2 = 255).
-inline constexpr uint16_t kEmcyCanErrorPassive = 0x8120;
-inline constexpr uint16_t kEmcyCanBusOffRecovered = 0x8140;
 
 using PdoCommunication = canopen::PdoCommunication;
 using PdoMapping = canopen::PdoMapping;  // entries 1..kMaxMappedObjects used
@@ -156,7 +152,7 @@ class Tmcm3216 final : private canopen::LssDevice {
   CommunicationConfig& communication() { return communication_; }
   NodeSettings& node_settings() { return node_settings_; }
   const Tmcm3216Config& config() const { return config_; }
-  cia402::AxisDrive& drive(uint8_t axis) { return drives_[axis]; }
+  Tmcm3216Drive& drive(uint8_t axis) { return drives_[axis]; }
   Tmcm3216Stepper& stepper(uint8_t axis) { return steppers_[axis]; }
   Tmcm3216GeneralIo& general_io() { return general_io_; }
   const Tmcm3216Emergencies& emergencies() const { return emergencies_; }
@@ -216,7 +212,7 @@ class Tmcm3216 final : private canopen::LssDevice {
   uint32_t service_elapsed_us_ = 0;
 
   std::array<Tmcm3216Stepper, kAxisCount> steppers_{};
-  std::array<cia402::AxisDrive, kAxisCount> drives_{};
+  std::array<Tmcm3216Drive, kAxisCount> drives_{};
   Tmcm3216GeneralIo general_io_{};
   Tmcm3216Emergencies emergencies_{};  // table 365 per axis: the single sender of the axes' EMCYs
 

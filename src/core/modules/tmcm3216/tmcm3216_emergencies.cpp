@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "board/stepper_drive.h"
-#include "core/cia402/axis_drive.h"
+#include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
 
 namespace motwin::modules::tmcm3216 {
@@ -90,7 +90,7 @@ const EmergencyDefinition& emergency_definition(AxisCondition condition) {
   return kTable[static_cast<size_t>(condition)];
 }
 
-AxisConditions conditions_of(const Tmcm3216Stepper& stepper, const cia402::AxisDrive& drive) {
+AxisConditions conditions_of(const Tmcm3216Stepper& stepper, const Tmcm3216Drive& drive) {
   AxisConditions c;
   c.driver_errors = stepper.driver_error_flags();
   c.stall = stepper.stall_detected();

@@ -18,12 +18,15 @@
 #include "core/canopen/emergency.h"
 
 namespace motwin::cia402 {
+template <class Manufacturer>
 class AxisDrive;
 }
 
 namespace motwin::modules::tmcm3216 {
 
 class Tmcm3216Stepper;
+struct Tmcm3216DriveObjects;
+using Tmcm3216Drive = cia402::AxisDrive<Tmcm3216DriveObjects>;  // tmcm3216_drive.h
 
 inline constexpr uint8_t kEmergencyAxisCount = 3;
 inline constexpr uint8_t kEmergencyNoMotor = 255;  // additional byte 2 of module-wide messages
@@ -40,14 +43,16 @@ inline constexpr uint16_t kEmcyShutdownSwitch = 0x5441;
 inline constexpr uint16_t kEmcyFollowingError = 0x8611;
 inline constexpr uint16_t kEmcyUndervoltage = 0xFF00;
 inline constexpr uint16_t kEmcyLimit = 0xFF01;
+// Table 365's code for an RPDO whose data the drive refused ("parameter error").
+inline constexpr uint16_t kEmcyPdoParameter = 0x6320;
 
 // 1001 bits (CiA-301 table 47; manual table 11).
-inline constexpr uint8_t kErrorRegisterGeneric = 0x01;
-inline constexpr uint8_t kErrorRegisterCurrent = 0x02;
-inline constexpr uint8_t kErrorRegisterVoltage = 0x04;
-inline constexpr uint8_t kErrorRegisterTemperature = 0x08;
-inline constexpr uint8_t kErrorRegisterDeviceProfile = 0x20;
-inline constexpr uint8_t kErrorRegisterManufacturer = 0x80;
+using canopen::kErrorRegisterCurrent;
+using canopen::kErrorRegisterDeviceProfile;
+using canopen::kErrorRegisterGeneric;
+using canopen::kErrorRegisterManufacturer;
+using canopen::kErrorRegisterTemperature;
+using canopen::kErrorRegisterVoltage;
 // 1001 bits of an axis in FAULT (or its fault reaction), whatever the cause: the module sets
 // them from the PDS state; a fault's EMCY carries them already (it is what the report sets).
 inline constexpr uint8_t kErrorRegisterAxisFault = kErrorRegisterGeneric | kErrorRegisterDeviceProfile;
@@ -114,7 +119,7 @@ struct AxisConditions {
 };
 
 // The conditions of an axis from its stepper and drive (the module's wiring in one call).
-AxisConditions conditions_of(const Tmcm3216Stepper& stepper, const cia402::AxisDrive& drive);
+AxisConditions conditions_of(const Tmcm3216Stepper& stepper, const Tmcm3216Drive& drive);
 
 struct EmergencyResult {
   ConditionMask raised = 0;  // conditions that rose now (an EMCY each)

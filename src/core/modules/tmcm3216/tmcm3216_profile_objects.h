@@ -4,7 +4,7 @@
 //
 // Templates over the module profile `Owner` (Tmcm3216) and its `Table`, like
 // tmcm3216_manufacturer_objects.h. Owner provides:
-//   cia402::AxisDrive& drive(uint8_t axis);
+//   Tmcm3216Drive& drive(uint8_t axis);
 //   Tmcm3216Stepper& stepper(uint8_t axis);
 // Configuration objects are stored with the motor's parameters (1010 sub 4 + n); the controlword,
 // mode and set-points are not (they start at their defaults after a reset, as CiA-402 drives do).
@@ -15,9 +15,9 @@
 #include <string_view>
 
 #include "core/canopen/object_rows.h"
-#include "core/cia402/axis_drive.h"
 #include "core/cia402/homing.h"
 #include "core/cia402/profile_objects.h"
+#include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "core/modules/tmcm3216/tmcm3216_manufacturer_objects.h"
 
 namespace motwin::modules::tmcm3216 {
@@ -41,6 +41,13 @@ constexpr EntryBinding<Owner> field() {
   return canopen::field_binding<Owner, [](Owner& d, uint8_t axis) -> auto& { return d.drive(axis).objects.*Member; }>();
 }
 
+// A binding to the Tmcm3216DriveObjects field `Member` (the drive's manufacturer part) of the row's axis.
+template <class Owner, auto Member>
+constexpr EntryBinding<Owner> manufacturer_field() {
+  return canopen::field_binding<Owner,
+                                [](Owner& d, uint8_t axis) -> auto& { return d.drive(axis).manufacturer.*Member; }>();
+}
+
 template <class Owner>
 constexpr EntryRow<Owner> axis_row(EntryRow<Owner> r, uint16_t stride, bool mappable, bool stored) {
   r.info.axis_stride = stride;
@@ -53,11 +60,18 @@ constexpr EntryRow<Owner> axis_row(EntryRow<Owner> r, uint16_t stride, bool mapp
 template <class Owner, auto Member>
 constexpr EntryRow<Owner> config_var(uint16_t index, std::string_view name, DataType type, int64_t min, int64_t max,
                                      int64_t default_value, bool mappable = false,
-                                     SdoAbort (*check)(Owner&, uint8_t, int64_t) = nullptr,
-                                     uint16_t stride = kProfileAxisStride) {
+                                     SdoAbort (*check)(Owner&, uint8_t, int64_t) = nullptr) {
   return axis_row(canopen::rows::var<Owner>(index, name, type, Access::kRw, min, max, default_value,
                                             canopen::rows::checked(field<Owner, Member>(), check)),
-                  stride, mappable, true);
+                  kProfileAxisStride, mappable, true);
+}
+
+// A stored rw VAR of the manufacturer area (+ n x 0x200) bound to a Tmcm3216DriveObjects field.
+template <class Owner, auto Member>
+constexpr EntryRow<Owner> ramp_var(uint16_t index, std::string_view name, DataType type, int64_t max) {
+  return axis_row(
+      canopen::rows::var<Owner>(index, name, type, Access::kRw, 0, max, 0, manufacturer_field<Owner, Member>()),
+      kManufacturerAxisStride, false, true);
 }
 
 template <class Owner, auto Member>
@@ -113,7 +127,7 @@ SdoAbort check_homing_method(Owner&, uint8_t, int64_t v) {
 // 208C: 0 or 181, only in SWITCH ON DISABLED (manual 4.2.19).
 template <class Owner>
 SdoAbort check_velocity_dimension(Owner& d, uint8_t axis, int64_t v) {
-  if (v != cia402::kVelocityDimensionInternal && v != cia402::kVelocityDimensionPps) return SdoAbort::kInvalidValue;
+  if (v != kVelocityDimensionInternal && v != kVelocityDimensionPps) return SdoAbort::kInvalidValue;
   const cia402::PdsState state = d.drive(axis).state();
   return state == cia402::PdsState::kSwitchOnDisabled || state == cia402::PdsState::kNotReadyToSwitchOn
              ? SdoAbort::kNone
@@ -177,7 +191,7 @@ constexpr void add_profile_rows(Table& t) {
                                                 false, &check_sensor_selection<Owner>));
   t.add(reading<Owner>(0x606C, "Velocity actual value", kInteger32, r::kI32Min, r::kI32Max,
                        [](Owner& d, uint8_t a) -> int64_t { return d.drive(a).velocity_actual_value(); }));
-  t.add(set_point<Owner, &O::target_position, &cia402::AxisDrive::target_position_written>(0x607A, "Target position"));
+  t.add(set_point<Owner, &O::target_position, &Tmcm3216Drive::target_position_written>(0x607A, "Target position"));
   t.add(config_var<Owner, &O::home_offset>(0x607C, "Home offset", kInteger32, r::kI32Min, r::kI32Max, 0));
   t.add(r::per_axis(r::highest_sub<Owner>(0x607D, ObjectCode::kArray, "Software position limit", 2), kStride));
   t.add(config_entry<Owner, &O::software_limit_min>(0x607D, 1, ObjectCode::kArray, "Software position limit",
@@ -226,7 +240,7 @@ constexpr void add_profile_rows(Table& t) {
                                                      "Interpolation time index", kInteger8, -3, 3, -3));
   t.add(config_var<Owner, &O::positioning_option>(0x60F2, "Positioning option code", kUnsigned16, 0, 2, 0));
   add_digital_inputs_row<Owner>(t);  // 60FD (hstepper's rows)
-  t.add(set_point<Owner, &O::target_velocity, &cia402::AxisDrive::target_velocity_written>(0x60FF, "Target velocity"));
+  t.add(set_point<Owner, &O::target_velocity, &Tmcm3216Drive::target_velocity_written>(0x60FF, "Target velocity"));
   t.add(r::per_axis(r::var<Owner>(0x6502, "Supported drive modes", kUnsigned32, Access::kRo, 0, r::kU32Max,
                                   cia402::kSupportedDriveModes),
                     kStride));
@@ -240,39 +254,37 @@ template <class Owner, class Table>
 constexpr void add_ramp_rows(Table& t) {
   using namespace profile_rows;
   using enum DataType;
-  using O = cia402::ProfileObjects;
+  using M = Tmcm3216DriveObjects;
   namespace r = canopen::rows;
   constexpr uint16_t kStride = kManufacturerAxisStride;
   constexpr int64_t kVelocityMax = 16777215;
-  t.add(config_var<Owner, &O::start_velocity>(0x2010, "Profile start velocity", kUnsigned32, 0, 268435455, 0, false,
-                                              nullptr, kStride));
-  t.add(config_var<Owner, &O::a1>(0x2011, "Profile A1", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
-  t.add(config_var<Owner, &O::v1>(0x2012, "Profile V1", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
-  t.add(config_var<Owner, &O::d1>(0x2013, "Profile D1", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
-  t.add(config_var<Owner, &O::ramp_wait_time>(0x2015, "Ramp wait time", kUnsigned16, 0, r::kU16Max, 0, false, nullptr,
-                                              kStride));
-  t.add(config_var<Owner, &O::a2>(0x2016, "Profile A2", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
-  t.add(config_var<Owner, &O::v2>(0x2017, "Profile V2", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
-  t.add(config_var<Owner, &O::d2>(0x2018, "Profile D2", kUnsigned32, 0, kVelocityMax, 0, false, nullptr, kStride));
+  t.add(ramp_var<Owner, &M::start_velocity>(0x2010, "Profile start velocity", kUnsigned32, 268435455));
+  t.add(ramp_var<Owner, &M::a1>(0x2011, "Profile A1", kUnsigned32, kVelocityMax));
+  t.add(ramp_var<Owner, &M::v1>(0x2012, "Profile V1", kUnsigned32, kVelocityMax));
+  t.add(ramp_var<Owner, &M::d1>(0x2013, "Profile D1", kUnsigned32, kVelocityMax));
+  t.add(ramp_var<Owner, &M::ramp_wait_time>(0x2015, "Ramp wait time", kUnsigned16, r::kU16Max));
+  t.add(ramp_var<Owner, &M::a2>(0x2016, "Profile A2", kUnsigned32, kVelocityMax));
+  t.add(ramp_var<Owner, &M::v2>(0x2017, "Profile V2", kUnsigned32, kVelocityMax));
+  t.add(ramp_var<Owner, &M::d2>(0x2018, "Profile D2", kUnsigned32, kVelocityMax));
   {
-    EntryBinding<Owner> b = field<Owner, &O::velocity_dimension>();
+    EntryBinding<Owner> b = manufacturer_field<Owner, &M::velocity_dimension>();
     b.set = [](Owner& d, uint8_t a, int64_t v) {
-      d.drive(a).objects.velocity_dimension = static_cast<uint8_t>(v);
-      d.stepper(a).objects.velocity_in_chip_units = v == cia402::kVelocityDimensionInternal;
+      d.drive(a).manufacturer.velocity_dimension = static_cast<uint8_t>(v);
+      d.stepper(a).objects.velocity_in_chip_units = v == kVelocityDimensionInternal;
       return SdoAbort::kNone;
     };
     b.check = &check_velocity_dimension<Owner>;
     t.add(axis_row(r::var<Owner>(0x208C, "Velocity dimension index", kUnsigned8, Access::kRw, 0, r::kU8Max,
-                                 cia402::kVelocityDimensionPps, b),
+                                 kVelocityDimensionPps, b),
                    kStride, false, true));
   }
   t.add(reading<Owner>(0x208E, "Acceleration dimension index", kUnsigned8, 0, r::kU8Max,
                        [](Owner& d, uint8_t a) -> int64_t {
-                         return d.drive(a).objects.velocity_dimension == cia402::kVelocityDimensionInternal
-                                    ? cia402::kAccelerationDimensionInternal
-                                    : cia402::kAccelerationDimensionPps2;
+                         return d.drive(a).manufacturer.velocity_dimension == kVelocityDimensionInternal
+                                    ? kAccelerationDimensionInternal
+                                    : kAccelerationDimensionPps2;
                        },
-                       false, kStride, cia402::kAccelerationDimensionPps2));
+                       false, kStride, kAccelerationDimensionPps2));
   t.add(reading<Owner>(0x2100, "Home offset display", kInteger32, r::kI32Min, r::kI32Max,
                        [](Owner& d, uint8_t a) -> int64_t { return d.drive(a).objects.home_offset; }, false, kStride));
 }

@@ -231,7 +231,7 @@ void Tmcm3216Stepper::run_stallguard(const board::StepperFeedback& feedback, con
   if (!power_on_) return;
   motion::StallDetectorConfig config;
   config.stop_velocity_pps = saturate_u32(velocity_object_pps(objects.stop_on_stall_velocity));
-  config.reaction = objects.stop_on_stall_option == 0 ? motion::StallReaction::kFault : motion::StallReaction::kStop;
+  stall_reaction_of(objects.stop_on_stall_option, config.reaction);
   config.stallguard4_threshold = objects.stallguard4_threshold;
   motion::StallDetectorInputs inputs;
   inputs.velocity_pps = demand.velocity_pps;

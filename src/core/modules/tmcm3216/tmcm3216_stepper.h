@@ -32,6 +32,14 @@ inline constexpr int32_t kCurrentRangePeakMa[4] = {1000, 2000, 3000, 3000};
 // Below this supply the driver flags undervoltage (2102 bit 5) and cannot drive the motor.
 inline constexpr int32_t kUndervoltageMillivolt = 8000;
 
+// 20A7 (stop on stall option code, manual 4.2.39): 0 FAULT, 1 stop only. false for a value out
+// of range (`out` untouched).
+constexpr bool stall_reaction_of(uint8_t option_code, motion::StallReaction& out) {
+  if (option_code > 1) return false;
+  out = option_code == 0 ? motion::StallReaction::kFault : motion::StallReaction::kStop;
+  return true;
+}
+
 // 2005 bits (manual table 62).
 namespace switch_bits {
 inline constexpr uint32_t kLeftDisabled = 1u << 0;

@@ -1,30 +1,37 @@
-#include "core/cia402/axis_drive.h"
+// The member definitions of cia402::AxisDrive (axis_drive.h). A module includes this file once,
+// in the source file that instantiates its drive with its part
+// (`template class cia402::AxisDrive<Part>;`, e.g. src/core/modules/tmcm3216/tmcm3216_drive.cpp);
+// every other file includes only axis_drive.h.
+#pragma once
 
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 
+#include "core/cia402/axis_drive.h"
+
 namespace motwin::cia402 {
 
-namespace {
+namespace drive_detail {
 
-constexpr int32_t kMin32 = std::numeric_limits<int32_t>::min();
-constexpr int32_t kMax32 = std::numeric_limits<int32_t>::max();
+inline constexpr int32_t kMin32 = std::numeric_limits<int32_t>::min();
+inline constexpr int32_t kMax32 = std::numeric_limits<int32_t>::max();
 
-int32_t wrap(int64_t value) { return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(value))); }
-int32_t difference(int32_t a, int32_t b) { return wrap(static_cast<int64_t>(a) - b); }
-// 6099 and 609A/6083 take the whole UNSIGNED32 range (manual tables 260, 315, 317) and internal
-// units (208C/208E) scale them further: a speed or acceleration the int32 homing config cannot
+inline int32_t wrap(int64_t value) { return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(value))); }
+inline int32_t difference(int32_t a, int32_t b) { return wrap(static_cast<int64_t>(a) - b); }
+// 6099 and 609A/6083 take the whole UNSIGNED32 range (manual tables 260, 315, 317) and the
+// module's units may scale them further: a speed or acceleration the int32 homing config cannot
 // hold runs at the largest it can (a cast would be undefined behaviour).
-int32_t saturate_to_int32(double value) {
+inline int32_t saturate_to_int32(double value) {
   if (value >= static_cast<double>(kMax32)) return kMax32;
   if (value <= static_cast<double>(kMin32)) return kMin32;
   return static_cast<int32_t>(value);
 }
 
-}  // namespace
+}  // namespace drive_detail
 
-void AxisDrive::reset(int32_t position) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::reset(int32_t position) {
   pds_.reset();
   ramp_ = motion::EightPointRamp{};
   ramp_.set_position(position);
@@ -54,7 +61,6 @@ void AxisDrive::reset(int32_t position) {
   stall_latched_ = false;
   stall_stop_ = false;
   clear_stall_request_ = false;
-  previous_driver_errors_ = 0;
   actual_position_ = position;
   last_encoder_usteps_ = 0;
   encoder_offset_ = 0;
@@ -64,7 +70,8 @@ void AxisDrive::reset(int32_t position) {
   emcy_count_ = 0;
 }
 
-PdsOptions AxisDrive::options() const {
+template <class Manufacturer>
+PdsOptions AxisDrive<Manufacturer>::options() const {
   PdsOptions o;
   o.quick_stop = objects.quick_stop_option;
   o.shutdown = objects.shutdown_option;
@@ -74,13 +81,15 @@ PdsOptions AxisDrive::options() const {
   return o;
 }
 
-void AxisDrive::emergency(uint16_t code, uint8_t sub) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::emergency(DriveEvent event) {
   if (emcy_count_ == emcy_.size()) return;  // the oldest are kept: they name the first cause
-  emcy_[(emcy_head_ + emcy_count_) % emcy_.size()] = AxisEmergency{code, sub};
+  emcy_[(emcy_head_ + emcy_count_) % emcy_.size()] = Manufacturer::emergency(event);
   ++emcy_count_;
 }
 
-bool AxisDrive::take_emergency(AxisEmergency& out) {
+template <class Manufacturer>
+bool AxisDrive<Manufacturer>::take_emergency(AxisEmergency& out) {
   if (emcy_count_ == 0) return false;
   out = emcy_[emcy_head_];
   emcy_head_ = (emcy_head_ + 1) % emcy_.size();
@@ -88,15 +97,17 @@ bool AxisDrive::take_emergency(AxisEmergency& out) {
   return true;
 }
 
-bool AxisDrive::take_position_assignment(int32_t& position) {
+template <class Manufacturer>
+bool AxisDrive<Manufacturer>::take_position_assignment(int32_t& position) {
   if (!position_assigned_) return false;
   position = assigned_position_;
   position_assigned_ = false;
   return true;
 }
 
-void AxisDrive::assign_position(int32_t position) {
-  encoder_offset_ = difference(position, last_encoder_usteps_);
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::assign_position(int32_t position) {
+  encoder_offset_ = drive_detail::difference(position, last_encoder_usteps_);
   ramp_.set_position(position);
   ramp_.halt();
   target_ = position;
@@ -108,41 +119,37 @@ void AxisDrive::assign_position(int32_t position) {
 
 // --- Units and profiles -----------------------------------------------------------------------
 
-motion::EightPointConfig AxisDrive::profile_config() const {
+template <class Manufacturer>
+motion::EightPointConfig AxisDrive<Manufacturer>::profile_config() const {
   const UnitScale u = units();
+  // The profile objects make a plain trapezoid: the segments below V1 and V2 brake with DMAX.
   motion::EightPointConfig c;
-  c.vstart_pps = u.velocity_pps(objects.start_velocity);
-  c.a1_pps2 = u.acceleration_pps2(objects.a1);
-  c.v1_pps = u.velocity_pps(objects.v1);
-  c.a2_pps2 = u.acceleration_pps2(objects.a2);
-  c.v2_pps = u.velocity_pps(objects.v2);
   c.vmax_pps = u.velocity_pps(objects.profile_velocity);
   c.amax_pps2 = u.acceleration_pps2(objects.profile_acceleration);
   c.dmax_pps2 = u.acceleration_pps2(objects.profile_deceleration);
-  c.d2_pps2 = u.acceleration_pps2(objects.d2);
-  c.d1_pps2 = u.acceleration_pps2(objects.d1);
+  c.d1_pps2 = c.dmax_pps2;
+  c.d2_pps2 = c.dmax_pps2;
   c.vstop_pps = u.velocity_pps(objects.end_velocity);
-  c.tzerowait_us = static_cast<uint32_t>(objects.ramp_wait_time) * 32u;
-  // The manual's defaults have D1 = D2 = 0 with V1 = V2 = 0: a plain trapezoid. The segments
-  // that are not in use brake with DMAX (docs "Decisions").
-  if (c.v1_pps == 0.0 && c.d1_pps2 == 0.0) c.d1_pps2 = c.dmax_pps2;
-  if (c.v2_pps == 0.0 && c.d2_pps2 == 0.0) c.d2_pps2 = c.dmax_pps2;
+  manufacturer.shape_profile(c, u);
   return c;
 }
 
-bool AxisDrive::min_limit(int64_t& limit) const {
-  if (objects.software_limit_min == kMin32) return false;
+template <class Manufacturer>
+bool AxisDrive<Manufacturer>::min_limit(int64_t& limit) const {
+  if (objects.software_limit_min == drive_detail::kMin32) return false;
   limit = static_cast<int64_t>(objects.software_limit_min) - objects.home_offset;
   return true;
 }
 
-bool AxisDrive::max_limit(int64_t& limit) const {
-  if (objects.software_limit_max == kMax32) return false;
+template <class Manufacturer>
+bool AxisDrive<Manufacturer>::max_limit(int64_t& limit) const {
+  if (objects.software_limit_max == drive_detail::kMax32) return false;
   limit = static_cast<int64_t>(objects.software_limit_max) - objects.home_offset;
   return true;
 }
 
-double AxisDrive::slow_down_pps2() const {
+template <class Manufacturer>
+double AxisDrive<Manufacturer>::slow_down_pps2() const {
   // "The slow down ramp is the deceleration value of the used mode of operation" (5.1.1).
   const UnitScale u = units();
   double value = 0;
@@ -156,7 +163,8 @@ double AxisDrive::slow_down_pps2() const {
   return u.acceleration_pps2(value);
 }
 
-double AxisDrive::interpolation_period_s() const {
+template <class Manufacturer>
+double AxisDrive<Manufacturer>::interpolation_period_s() const {
   double period = objects.interpolation_period;
   for (int i = 0; i < std::abs(objects.interpolation_index); ++i) {
     period = objects.interpolation_index < 0 ? period / 10.0 : period * 10.0;
@@ -164,7 +172,8 @@ double AxisDrive::interpolation_period_s() const {
   return period;
 }
 
-void AxisDrive::stop_ramp(double deceleration_pps2) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::stop_ramp(double deceleration_pps2) {
   if (deceleration_pps2 <= 0.0) {
     ramp_.halt();  // no ramp configured: stop at once
     return;
@@ -174,7 +183,8 @@ void AxisDrive::stop_ramp(double deceleration_pps2) {
 
 // --- Controlword and set-points --------------------------------------------------------------
 
-void AxisDrive::write_controlword(uint16_t controlword) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::write_controlword(uint16_t controlword) {
   const uint16_t previous = controlword_;
   controlword_ = controlword;
   const PdsState before = pds_.state();
@@ -183,7 +193,7 @@ void AxisDrive::write_controlword(uint16_t controlword) {
     following_error_ = false;
     stall_latched_ = false;
     clear_stall_request_ = true;  // the stepper's stall flag is cleared in the next tick
-    emergency(kEmcyFaultReset);
+    emergency(DriveEvent::kFaultReset);
   }
   if (before != PdsState::kOperationEnabled && pds_.state() == PdsState::kOperationEnabled) {
     // Operation enabled anew: pp stands on its position until a new set-point comes.
@@ -215,7 +225,8 @@ void AxisDrive::write_controlword(uint16_t controlword) {
   }
 }
 
-void AxisDrive::accept_set_point(uint16_t controlword) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::accept_set_point(uint16_t controlword) {
   if (pending_) return;  // the buffer is full: bit 12 stays set, the edge is not taken
   const motion::EightPointConfig config = profile_config();
   if (motion::EightPointRamp::validate(config) != motion::EightPointConfigError::kNone || config.vmax_pps <= 0.0) {
@@ -253,22 +264,24 @@ void AxisDrive::accept_set_point(uint16_t controlword) {
   }
 }
 
-int32_t AxisDrive::set_point_target() {
-  int64_t target = wrap(static_cast<int64_t>(objects.target_position) + set_point_base_);
+template <class Manufacturer>
+int32_t AxisDrive<Manufacturer>::set_point_target() {
+  int64_t target = drive_detail::wrap(static_cast<int64_t>(objects.target_position) + set_point_base_);
   int64_t limit = 0;
   if (min_limit(limit) && target < limit) target = limit;
   if (max_limit(limit) && target > limit) target = limit;
   return static_cast<int32_t>(target);
 }
 
-void AxisDrive::start_homing() {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::start_homing() {
   const UnitScale u = units();
   HomingConfig config;
-  config.fast_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_fast));
-  config.slow_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_slow));
+  config.fast_speed_pps = drive_detail::saturate_to_int32(u.velocity_pps(objects.homing_speed_fast));
+  config.slow_speed_pps = drive_detail::saturate_to_int32(u.velocity_pps(objects.homing_speed_slow));
   const uint32_t acceleration =
       objects.homing_acceleration != 0 ? objects.homing_acceleration : objects.profile_acceleration;
-  config.acceleration_pps2 = saturate_to_int32(u.acceleration_pps2(acceleration));
+  config.acceleration_pps2 = drive_detail::saturate_to_int32(u.acceleration_pps2(acceleration));
   config.home_offset_usteps = objects.home_offset;
   // An index method finds its pulse within one revolution; two allow for the edge's position.
   config.index_search_limit_usteps = 2 * usteps_per_revolution_;
@@ -287,7 +300,8 @@ void AxisDrive::start_homing() {
   }
 }
 
-void AxisDrive::target_position_written() {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::target_position_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kProfilePosition) && set_point_taken_in_tick_ &&
       (controlword_ & kCwNewSetPoint) != 0) {
     // An RPDO that maps 6040 before 607A (RPDO 3, ros2_canopen's pp PDO) writes the controlword
@@ -306,7 +320,8 @@ void AxisDrive::target_position_written() {
   }
 }
 
-void AxisDrive::target_velocity_written() {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::target_velocity_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kProfileVelocity)) {
     stall_stop_ = false;
     // Bit 10 drops with the write, not a tick later: a poll right after it sees the change.
@@ -317,17 +332,19 @@ void AxisDrive::target_velocity_written() {
   }
 }
 
-void AxisDrive::on_sync() {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::on_sync() {
   us_since_sync_ = 0;
   latch_cyclic_set_point();
 }
 
-void AxisDrive::latch_cyclic_set_point() {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
   const bool running = pds_.state() == PdsState::kOperationEnabled && pds_.motion() == PdsMotion::kRun;
   if (!running) return;
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncPosition)) {
     int64_t target = static_cast<int64_t>(objects.target_position) + objects.position_offset;
-    target = wrap(target);
+    target = drive_detail::wrap(target);
     int64_t limit = 0;
     if (min_limit(limit) && target < limit) target = limit;
     if (max_limit(limit) && target > limit) target = limit;
@@ -346,7 +363,8 @@ void AxisDrive::latch_cyclic_set_point() {
 
 // --- The tick ---------------------------------------------------------------------------------
 
-void AxisDrive::on_mode_change(int8_t from, int8_t to) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::on_mode_change(int8_t from, int8_t to) {
   if (from == static_cast<int8_t>(Mode::kHoming) && homing_.active()) homing_.stop();
   cyclic_latched_ = false;
   halted_ = false;
@@ -367,7 +385,8 @@ void AxisDrive::on_mode_change(int8_t from, int8_t to) {
   }
 }
 
-void AxisDrive::step(const AxisInputs& inputs, uint32_t dt_us) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   const double dt_s = static_cast<double>(dt_us) * 1e-6;
   // A stall flag the drive asked to clear is still set in this tick's readings: not a new stall.
   AxisInputs in = inputs;
@@ -382,7 +401,7 @@ void AxisDrive::step(const AxisInputs& inputs, uint32_t dt_us) {
     on_mode_change(from, active_mode_);
   }
   last_encoder_usteps_ = inputs.encoder_position_usteps;
-  in.encoder_position_usteps = wrap(static_cast<int64_t>(inputs.encoder_position_usteps) + encoder_offset_);
+  in.encoder_position_usteps = drive_detail::wrap(static_cast<int64_t>(inputs.encoder_position_usteps) + encoder_offset_);
   actual_position_ = objects.sensor_selection == 0 ? in.encoder_position_usteps : ramp_.position();
   check_faults(in);
   run_pds_motion(in, dt_s);
@@ -400,25 +419,26 @@ void AxisDrive::step(const AxisInputs& inputs, uint32_t dt_us) {
   demand_.switch_on_disabled = state == PdsState::kSwitchOnDisabled || state == PdsState::kNotReadyToSwitchOn;
 }
 
-void AxisDrive::check_faults(const AxisInputs& inputs) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::check_faults(const AxisInputs& inputs) {
   const bool powered = pds_.power_enabled();
   // Following error (6065 with 606A = 0): demand against the encoder.
   if (powered && objects.sensor_selection == 0 && objects.following_error_window != 0 && !following_error_) {
-    const int64_t deviation = std::llabs(static_cast<int64_t>(difference(ramp_.position(), inputs.encoder_position_usteps)));
+    const int64_t deviation = std::llabs(static_cast<int64_t>(drive_detail::difference(ramp_.position(), inputs.encoder_position_usteps)));
     if (deviation > static_cast<int64_t>(objects.following_error_window)) {
       following_error_ = true;
-      emergency(kEmcyFollowingError);
+      emergency(DriveEvent::kFollowingError);
       pds_.fault();
     }
   }
-  // Stall (20A4 / 20A7): EMCY 3230, then FAULT or a quick stop.
+  // Stall: an emergency, then FAULT or a quick stop, as the module's stall reaction says.
   if (inputs.stall && !stall_latched_) {
     stall_latched_ = true;
-    emergency(kEmcyStall);
+    emergency(DriveEvent::kStall);
     if (inputs.stall_enters_fault) {
       pds_.fault();
     } else {
-      // 20A7 = 1: the axis stops and stays until the master commands a new motion.
+      // Stop only: the axis stops and stays until the master commands a new motion.
       stall_stop_ = true;
       moving_to_target_ = false;
       pending_ = false;
@@ -426,24 +446,12 @@ void AxisDrive::check_faults(const AxisInputs& inputs) {
       stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
     }
   }
-  // Driver errors: EMCY on each new one; the ones that keep the motor from running are faults.
-  const uint8_t errors = inputs.driver_errors;
-  const uint8_t raised = static_cast<uint8_t>(errors & ~previous_driver_errors_);
-  previous_driver_errors_ = errors;
-  if (raised & kDriverOpenLoadA) emergency(kEmcyOpenLoad, 1);
-  if (raised & kDriverOpenLoadB) emergency(kEmcyOpenLoad, 2);
-  if (raised & kDriverOvercurrentHighSide) emergency(kEmcyOvercurrentHighSide);
-  if (raised & kDriverOvercurrentB) emergency(kEmcyOvercurrentB);
-  if (raised & kDriverOvercurrentA) emergency(kEmcyOvercurrentA);
-  if (raised & kDriverTemperatureWarning) emergency(kEmcyOvertemperature, 1);
-  if (raised & kDriverOvertemperature) emergency(kEmcyOvertemperature, 0);
-  if (raised & kDriverUndervoltage) emergency(kEmcyUndervoltage);
-  constexpr uint8_t kFatal = kDriverOvercurrentA | kDriverOvercurrentB | kDriverOvercurrentHighSide |
-                             kDriverOvertemperature | kDriverUndervoltage;
-  if ((errors & kFatal) != 0 && powered) pds_.fault();
+  // A power-stage fault keeps the motor from running: FAULT while the power stage is on.
+  if (inputs.power_stage_fault && powered) pds_.fault();
 }
 
-void AxisDrive::run_pds_motion(const AxisInputs& inputs, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt_s) {
   switch (pds_.motion()) {
     case PdsMotion::kOff:
     case PdsMotion::kHold:
@@ -467,7 +475,7 @@ void AxisDrive::run_pds_motion(const AxisInputs& inputs, double dt_s) {
       ramp_.step(ramp_config_, dt_s);
       break;
     case PdsMotion::kRun:
-      // Operation enabled, but the brake is not open yet (200A, 2002 sub 2): nothing moves.
+      // Operation enabled, but the power stage or the brake is not ready yet: nothing moves.
       if (!inputs.ready && ramp_.standstill()) break;
       run_mode(inputs, dt_s);
       break;
@@ -480,13 +488,14 @@ void AxisDrive::run_pds_motion(const AxisInputs& inputs, double dt_s) {
   }
   if (stall_latched_ && ramp_.standstill() && pds_.state() != PdsState::kFault &&
       pds_.state() != PdsState::kFaultReactionActive) {
-    // A stall with 20A7 = 1 is over once the axis stands: the next one is detected again.
+    // A stall that only stopped the axis is over once it stands: the next one is detected again.
     stall_latched_ = false;
     clear_stall_request_ = true;
   }
 }
 
-void AxisDrive::run_mode(const AxisInputs& inputs, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_mode(const AxisInputs& inputs, double dt_s) {
   const bool halt = (controlword_ & kCwHalt) != 0;
   const Mode mode = static_cast<Mode>(active_mode_);
   halted_ = halt && mode != Mode::kHoming && mode != Mode::kNone;
@@ -517,7 +526,8 @@ void AxisDrive::run_mode(const AxisInputs& inputs, double dt_s) {
   }
 }
 
-void AxisDrive::update_limits(const AxisInputs& inputs) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::update_limits(const AxisInputs& inputs) {
   const int32_t position = ramp_.position();
   int64_t limit = 0;
   const bool above = max_limit(limit) && position >= limit;
@@ -526,22 +536,23 @@ void AxisDrive::update_limits(const AxisInputs& inputs) {
   limit_negative_ = inputs.left_limit || below;
   limit_active_ = limit_positive_ || limit_negative_;
   const double v = ramp_.velocity();
-  // EMCY FF01 once per excursion, when the axis runs into the limit.
-  auto report = [&](bool active, int index, uint8_t sub, bool moving_into) {
+  // An emergency once per excursion, when the axis runs into the limit.
+  auto report = [&](bool active, int index, DriveEvent event, bool moving_into) {
     if (!active) {
       limit_reported_[index] = false;
     } else if (moving_into && !limit_reported_[index]) {
       limit_reported_[index] = true;
-      emergency(kEmcyLimit, sub);
+      emergency(event);
     }
   };
-  report(above, 0, 1, v > 0);
-  report(below, 1, 2, v < 0);
-  report(inputs.right_limit, 2, 3, v > 0);
-  report(inputs.left_limit, 3, 4, v < 0);
+  report(above, 0, DriveEvent::kSoftwareLimitPositive, v > 0);
+  report(below, 1, DriveEvent::kSoftwareLimitNegative, v < 0);
+  report(inputs.right_limit, 2, DriveEvent::kLimitSwitchPositive, v > 0);
+  report(inputs.left_limit, 3, DriveEvent::kLimitSwitchNegative, v < 0);
 }
 
-bool AxisDrive::brake_onto_software_limit(double target_pps, double velocity_ramp_pps2, double dt_s) {
+template <class Manufacturer>
+bool AxisDrive<Manufacturer>::brake_onto_software_limit(double target_pps, double velocity_ramp_pps2, double dt_s) {
   const double v = ramp_.velocity();
   // Towards where the axis moves, or (standing) where the target would take it.
   const double heading = v != 0.0 ? v : target_pps;
@@ -578,7 +589,8 @@ bool AxisDrive::brake_onto_software_limit(double target_pps, double velocity_ram
   return true;
 }
 
-void AxisDrive::run_profile_position(const AxisInputs& inputs, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_profile_position(const AxisInputs& inputs, double dt_s) {
   ramp_config_ = profile_config();
   update_limits(inputs);
   if ((limit_positive_ && ramp_.velocity() > 0) || (limit_negative_ && ramp_.velocity() < 0)) {
@@ -619,7 +631,8 @@ void AxisDrive::run_profile_position(const AxisInputs& inputs, double dt_s) {
   }
 }
 
-void AxisDrive::run_profile_velocity(const AxisInputs& inputs, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_profile_velocity(const AxisInputs& inputs, double dt_s) {
   ramp_config_ = profile_config();
   // pv: AMAX both ways (6083), no D segments; VMAX bounds nothing but the target itself.
   const double target = units().velocity_pps(objects.target_velocity);
@@ -640,7 +653,8 @@ void AxisDrive::run_profile_velocity(const AxisInputs& inputs, double dt_s) {
   ramp_.step(ramp_config_, dt_s);
 }
 
-void AxisDrive::run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s) {
   limit_active_ = inputs.left_limit || inputs.right_limit;
   if (!homing_.active()) {
     if (!ramp_.standstill()) {
@@ -682,7 +696,8 @@ void AxisDrive::run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s
   if (command.kind != HomingCommand::Kind::kDone) ramp_.step(config, dt_s);
 }
 
-void AxisDrive::run_cyclic_position(double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_cyclic_position(double dt_s) {
   // csp: linear interpolation from the position at the last SYNC to the new set-point over one
   // interpolation period (60C2); without a new SYNC the axis holds the last set-point.
   const int32_t previous = ramp_.position();
@@ -691,15 +706,16 @@ void AxisDrive::run_cyclic_position(double dt_s) {
   if (cyclic_latched_) {
     cyclic_elapsed_s_ += dt_s;
     const double fraction = period <= 0.0 ? 1.0 : std::min(1.0, cyclic_elapsed_s_ / period);
-    const int32_t delta = difference(cyclic_to_, cyclic_from_);
-    position = wrap(static_cast<int64_t>(cyclic_from_) + std::llround(static_cast<double>(delta) * fraction));
+    const int32_t delta = drive_detail::difference(cyclic_to_, cyclic_from_);
+    position = drive_detail::wrap(static_cast<int64_t>(cyclic_from_) + std::llround(static_cast<double>(delta) * fraction));
   }
-  const double velocity = dt_s > 0.0 ? static_cast<double>(difference(position, previous)) / dt_s : 0.0;
+  const double velocity = dt_s > 0.0 ? static_cast<double>(drive_detail::difference(position, previous)) / dt_s : 0.0;
   ramp_.set_state(position, velocity);
   ramp_config_ = profile_config();
 }
 
-void AxisDrive::run_cyclic_velocity(const AxisInputs& inputs, double dt_s) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_cyclic_velocity(const AxisInputs& inputs, double dt_s) {
   // csv: the velocity ramps linearly to the new set-point within one interpolation period.
   const double period = interpolation_period_s();
   motion::EightPointConfig config;
@@ -727,7 +743,8 @@ void AxisDrive::run_cyclic_velocity(const AxisInputs& inputs, double dt_s) {
   ramp_config_.amax_pps2 = ramp_config_.dmax_pps2 = quick_stop_pps2;
 }
 
-void AxisDrive::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_us) {
+template <class Manufacturer>
+void AxisDrive<Manufacturer>::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_us) {
   const Mode mode = static_cast<Mode>(active_mode_);
   if (halted_) {
     target_reached_ = ramp_.standstill();
@@ -745,7 +762,7 @@ void AxisDrive::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_
         target_reached_ = demand_there;
         break;
       }
-      const int64_t error = std::llabs(static_cast<int64_t>(difference(position_actual(), target_)));
+      const int64_t error = std::llabs(static_cast<int64_t>(drive_detail::difference(position_actual(), target_)));
       if (demand_there && error <= static_cast<int64_t>(window)) {
         in_window_us_ += dt_us;
       } else {
@@ -759,16 +776,18 @@ void AxisDrive::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_
   }
 }
 
-int32_t AxisDrive::position_actual() const { return actual_position_; }
+template <class Manufacturer>
+int32_t AxisDrive<Manufacturer>::position_actual() const { return actual_position_; }
 
-int32_t AxisDrive::velocity_actual_value() const { return units().velocity_value(ramp_.velocity()); }
+template <class Manufacturer>
+int32_t AxisDrive<Manufacturer>::velocity_actual_value() const { return units().velocity_value(ramp_.velocity()); }
 
-uint16_t AxisDrive::statusword() const {
+template <class Manufacturer>
+uint16_t AxisDrive<Manufacturer>::statusword() const {
   uint16_t sw = pds_.statusword_state_bits() | kSwRemote;
   if (set_point_refused_) sw |= kSwWarning;
   if (limit_active_) sw |= kSwInternalLimit;
-  if (!ramp_.standstill()) sw |= kSwMotorActivity;
-  if (negative_direction_) sw |= kSwDirection;
+  sw |= Manufacturer::manufacturer_status_bits(!ramp_.standstill(), negative_direction_);
   const bool enabled = pds_.state() == PdsState::kOperationEnabled;
   if (following_error_) sw |= kSwOms13;  // pp and csp define it; kept in FAULT as the cause
   // The other mode-specific bits mean something only while the drive function runs.
@@ -782,7 +801,7 @@ uint16_t AxisDrive::statusword() const {
       if (target_reached_) sw |= kSwTargetReached;
       break;
     case Mode::kHoming:
-      // notes/canopen.md: bit 10 while idle, cleared while homing, set with bit 12 when done.
+      // Bit 10 while idle, cleared while homing, set with bit 12 when done (docs/tmcm-3216-drive.md).
       if (!homing_.active()) sw |= kSwTargetReached;
       if (homing_.attained()) sw |= kSwOms12;
       if (homing_.error()) sw |= kSwOms13;
