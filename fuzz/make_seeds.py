@@ -636,6 +636,15 @@ def text_file_seeds():
 }
 """)
     write("motor_description", "dc", '{"name": "dc", "type": "dc", "torque_constant_nm_per_a": 0.05}\n')
+    write("motor_description", "startup", """{
+  "name": "named", "pole_pairs": 4, "torque_constant_nm_per_a": 0.035,
+  "startup": {"max_current_ma": 2000, "open_loop_current_ma": 1000, "commutation": "hall",
+              "position_sensor": "abn_encoder", "hall_interpolation": true, "encoder_alignment": "hall",
+              "brake_chopper_voltage_v": 52, "current_p": 461, "current_i": 3932, "velocity_p": 1200,
+              "velocity_i": 1200, "position_p": 300},
+  "axis_parameters": {"11": 1500}
+}
+""")
 
 
 def tmcm142_board_seeds():

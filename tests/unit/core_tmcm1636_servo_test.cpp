@@ -240,7 +240,7 @@ TEST(Tmcm1636Servo, hall_polarity_mismatch_does_not_run) {
 // away backwards: 160° electrical off). SAP 15, 0, 3 initialises, then it works.
 TEST(Tmcm1636Servo, abn_before_initialisation_misbehaves_and_works_after) {
   sim::MotorDescription motor = default_motor();
-  motor.startup_parameters.push_back({15, 3});
+  motor.startup->commutation = sim::CommutationSensor::kAbnEncoder;  // AP 15 = 3
   Tmcm1636ServoRig rig(motor);
   rig.sap(44, 20000);
   EXPECT_EQ(rig.gap(15), 3);

@@ -7,6 +7,7 @@
 
 #include "board/modules/tmcm1636/tmcm1636_power_stage.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
+#include "host/modules/tmcm1636/tmcm1636_startup_image.h"
 #include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/modules/tmcm1636/tmcm1636_plant.h"
 #include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
@@ -167,7 +168,8 @@ TEST(MotorDescription, json_round_trip_of_every_preset) {
     EXPECT_DOUBLE_EQ(parsed.motor->torque_constant(), preset.torque_constant());
     EXPECT_DOUBLE_EQ(parsed.motor->resistance_ohm, preset.resistance_ohm);
     EXPECT_EQ(parsed.motor->abn.counts_per_rev, preset.abn.counts_per_rev);
-    EXPECT_EQ(parsed.motor->startup_parameters.size(), preset.startup_parameters.size());
+    EXPECT_EQ(parsed.motor->axis_parameters.size(), preset.axis_parameters.size());
+    EXPECT_EQ(parsed.motor->startup, preset.startup);
   }
 }
 
@@ -182,7 +184,7 @@ TEST(MotorDescription, a_user_file_with_kv_and_comments) {
   ASSERT_TRUE(parsed.motor) << parsed.error;
   EXPECT_NEAR(parsed.motor->torque_constant(), 8.27 / 270.0, 1e-12);
   EXPECT_DOUBLE_EQ(parsed.motor->inductance_d_h, 2e-5);
-  EXPECT_EQ(parsed.motor->startup_parameters.size(), 2u);
+  EXPECT_EQ(parsed.motor->axis_parameters.size(), 2u);
 }
 
 // Found by fuzz/motor_description.cpp: JSON keys come sorted as text ("100" before "14"), and
@@ -192,10 +194,10 @@ TEST(MotorDescription, axis_parameters_in_number_order_and_each_number_once) {
       R"({"flux_linkage_wb": 0.005, "axis_parameters": {"100": 8192, "25": 1, "14": 3, "05": 7}})", "p.json");
   ASSERT_TRUE(parsed.motor) << parsed.error;
   const std::vector<std::pair<uint8_t, int32_t>> expected{{5, 7}, {14, 3}, {25, 1}, {100, 8192}};
-  EXPECT_EQ(parsed.motor->startup_parameters, expected);
+  EXPECT_EQ(parsed.motor->axis_parameters, expected);
   const MotorLoadResult again = parse_motor_description(motor_description_json(*parsed.motor), "q.json");
   ASSERT_TRUE(again.motor) << again.error;
-  EXPECT_EQ(again.motor->startup_parameters, expected);
+  EXPECT_EQ(again.motor->axis_parameters, expected);
   EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"5": 1, "05": 2}})", "r.json")
                 .error,
             "r.json: axis_parameters: parameter 5 is given twice");
@@ -207,7 +209,9 @@ TEST(MotorDescription, errors_name_the_file_and_the_problem) {
             "b.json: unknown key resistanse_ohm");
   EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 0, "flux_linkage_wb": 0.005})", "c.json").error,
             "c.json: pole_pairs must be from 1 to 255, got 0");
-  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"42": 1}})", "d.json").error,
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"42": 1}})", "d.json",
+                                    host::check_tmcm1636_axis_parameter)
+                .error,
             "d.json: axis_parameters: axis parameter 42 is not stored in the EEPROM");
   EXPECT_EQ(parse_motor_description(R"({"type": "dc"})", "e.json").error, "e.json: a DC motor needs torque_constant_nm_per_a");
   EXPECT_EQ(resolve_motor("fast-one").error,
@@ -216,13 +220,48 @@ TEST(MotorDescription, errors_name_the_file_and_the_problem) {
   EXPECT_TRUE(resolve_motor("ideal").error.empty());
 }
 
+// Start-up settings are named values in the motor's units; numbered firmware parameters are
+// kept as given unless the caller checks them for its firmware (the host does).
+TEST(MotorDescription, startup_settings_are_named_values_of_the_file) {
+  const MotorLoadResult parsed = parse_motor_description(
+      R"({"flux_linkage_wb": 0.005, "startup": {"max_current_ma": 1500, "commutation": "abn_encoder",
+          "hall_interpolation": false, "brake_chopper_voltage_v": 30.5}, "axis_parameters": {"42": 1}})",
+      "s.json");
+  ASSERT_TRUE(parsed.motor) << parsed.error;
+  ASSERT_TRUE(parsed.motor->startup);
+  const StartupSettings& startup = *parsed.motor->startup;
+  EXPECT_EQ(startup.max_current_ma, 1500);
+  EXPECT_EQ(startup.commutation, CommutationSensor::kAbnEncoder);
+  EXPECT_EQ(startup.hall_interpolation, false);
+  EXPECT_EQ(startup.brake_chopper_voltage_v, 30.5);
+  EXPECT_FALSE(startup.open_loop_current_ma);
+  EXPECT_FALSE(startup.encoder_alignment);
+  const std::vector<std::pair<uint8_t, int32_t>> kept{{42, 1}};
+  EXPECT_EQ(parsed.motor->axis_parameters, kept) << "no firmware check: the motor keeps the number";
+  const MotorLoadResult again = parse_motor_description(motor_description_json(*parsed.motor), "t.json");
+  ASSERT_TRUE(again.motor) << again.error;
+  EXPECT_EQ(again.motor->startup, parsed.motor->startup);
+
+  EXPECT_FALSE(parse_motor_description(R"({"flux_linkage_wb": 0.005})", "n.json").motor->startup);
+  EXPECT_TRUE(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {}})", "n.json").motor->startup);
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"commutation": "hal"}})", "e.json").error,
+            "e.json: startup.commutation must be one of \"open_loop\", \"hall\", \"abn_encoder\", "
+            "\"absolute_encoder\", got \"hal\"");
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"max_current": 1}})", "f.json").error,
+            "f.json: unknown key startup.max_current");
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"current_p": -1}})", "g.json").error,
+            "g.json: startup.current_p must be from 0 to 2.14748e+09, got -1");
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"256": 1}})", "h.json").error,
+            "h.json: axis_parameters: axis parameter 256 does not exist");
+}
+
 TEST(MotorDescription, startup_parameters_go_into_a_fresh_image) {
   using modules::tmcm1636::Tmcm1636;
   std::vector<uint8_t> image(Tmcm1636::kNvmLayout.total_size);
   Tmcm1636::format_factory_image(image.data(), image.size());
-  EXPECT_FALSE(image_configures_motor(image.data(), image.size()));
-  write_startup_parameters(*motor_preset("default-24v"), image.data(), image.size());
-  EXPECT_TRUE(image_configures_motor(image.data(), image.size()));
+  EXPECT_FALSE(host::tmcm1636_image_configures_motor(image.data(), image.size()));
+  host::write_tmcm1636_startup_image(*motor_preset("default-24v"), image.data(), image.size());
+  EXPECT_TRUE(host::tmcm1636_image_configures_motor(image.data(), image.size()));
   EXPECT_EQ(tmcl::get_le32(image.data() + Tmcm1636::kNvmLayout.axis_parameter(0, 100)), 4096);
   EXPECT_EQ(tmcl::get_le32(image.data() + Tmcm1636::kNvmLayout.axis_parameter(0, 15)), 2);
 }

@@ -10,6 +10,7 @@
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
+#include "host/modules/tmcm1636/tmcm1636_startup_image.h"
 #include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
 #include "sim/modules/tmcm1636/tmcm1636_sim_io.h"
@@ -32,7 +33,7 @@ struct Tmcm1636ServoRig {
                             int sub_steps = sim::Tmcm1636Plant::kDefaultSubSteps)
       : board(io, motor, seed, sub_steps) {
     Module::format_factory_image(nvm.mutable_data(), nvm.size());
-    if (startup) sim::write_startup_parameters(motor, nvm.mutable_data(), nvm.size());
+    if (startup) host::write_tmcm1636_startup_image(motor, nvm.mutable_data(), nvm.size());
     module.axis().attach_power_stage(board.power_stage());
     module.engine().power_up();
   }

@@ -1,12 +1,14 @@
 #include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
 
+#include "host/modules/tmcm1636/tmcm1636_startup_image.h"
+
 namespace motwin::host {
 
 MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
   MakeModuleResult result;
   std::unique_ptr<Tmcm1636VirtualModule> module(new Tmcm1636VirtualModule());
   // The motor is checked before any file is touched.
-  sim::MotorLoadResult motor = sim::resolve_motor(options.motor);
+  sim::MotorLoadResult motor = resolve_tmcm1636_motor(options.motor);
   if (!motor.error.empty()) {
     result.error = motor.error;
     return result;
@@ -14,13 +16,13 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
   // A physical motor's start-up settings go into a fresh image (docs/tmcm-1636-servo.md).
   const auto format_image = [&motor](uint8_t* image, size_t size) {
     Device::format_factory_image(image, size);
-    if (motor.motor) sim::write_startup_parameters(*motor.motor, image, size);
+    if (motor.motor) write_tmcm1636_startup_image(*motor.motor, image, size);
   };
   if (!module->eeprom_.open(options, eeprom_identity(), format_image, result.error)) return result;
   module->board_ = motor.motor ? std::make_unique<sim::Tmcm1636SimBoard>(module->io_, *motor.motor)
                                : std::make_unique<sim::Tmcm1636SimBoard>(module->io_);
   board::NonVolatileMemory& nvm = module->eeprom_.nvm();
-  if (motor.motor && module->eeprom_.file() && !sim::image_configures_motor(nvm.data(), nvm.size())) {
+  if (motor.motor && module->eeprom_.file() && !tmcm1636_image_configures_motor(nvm.data(), nvm.size())) {
     options.log("motwin: the EEPROM image " + module->eeprom_.location() + " has motor type 0 (no motor); " +
                 motor.motor->name + " start-up settings go into new images only (docs/tmcm-1636-servo.md)");
   }

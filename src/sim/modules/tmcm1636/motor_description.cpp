@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <span>
 #include <sstream>
@@ -10,17 +11,24 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/modules/tmcm1636/tmcm1636.h"
-
 namespace motwin::sim {
 namespace {
 
 using Json = nlohmann::json;
 using OrderedJson = nlohmann::ordered_json;
 
-// Start-up settings shared by the BLDC presets: three-phase BLDC, hall commutation (works at
-// once, no initialisation), position and velocity from the ABN encoder, hall interpolation on,
-// "use hall" as the encoder initialisation when a host selects ABN commutation (SAP 15, 0, 3).
+// Start-up settings shared by the BLDC presets: hall commutation (works at once, no
+// initialisation), position and velocity from the ABN encoder, hall interpolation on, the hall
+// sensors as the encoder alignment when a host selects ABN commutation (SAP 15, 0, 3).
+StartupSettings bldc_startup() {
+  StartupSettings s;
+  s.commutation = CommutationSensor::kHall;
+  s.position_sensor = PositionSensor::kAbnEncoder;
+  s.hall_interpolation = true;
+  s.encoder_alignment = EncoderAlignment::kHall;
+  return s;
+}
+
 MotorDescription default_24v() {
   MotorDescription m;
   m.name = "default-24v";
@@ -42,10 +50,15 @@ MotorDescription default_24v() {
   m.initial_angle_deg = 40.0;
   m.abn = {true, 4096, 200.0, false};
   m.supply = {24.0, 0.1, 470e-6, 10.0, false};
-  m.startup_parameters = {
-      {10, 4},     {11, 2000}, {12, 1000}, {14, 3},    {15, 2},  {25, 1},  {70, 461}, {71, 3932},
-      {72, 1200},  {73, 1200}, {74, 300},  {92, 1},    {100, 4096}, {102, 2},
-  };
+  StartupSettings s = bldc_startup();
+  s.max_current_ma = 2000;
+  s.open_loop_current_ma = 1000;
+  s.current_p = 461;  // current loop at 3000 rad/s: P = L w, I = R w (docs/tmcm-1636-servo.md)
+  s.current_i = 3932;
+  s.velocity_p = 1200;
+  s.velocity_i = 1200;
+  s.position_p = 300;
+  m.startup = s;
   return m;
 }
 
@@ -69,10 +82,16 @@ MotorDescription large_48v() {
   m.initial_angle_deg = 17.0;
   m.abn = {true, 8192, 0.0, false};
   m.supply = {48.0, 0.05, 1000e-6, 5.0, false};
-  m.startup_parameters = {
-      {10, 7},   {11, 10000}, {12, 3000}, {14, 3},  {15, 2},    {25, 1},   {70, 20},  {71, 639},
-      {72, 13100}, {73, 6300}, {74, 56},  {92, 1},  {100, 8192}, {102, 2}, {141, 520},
-  };
+  StartupSettings s = bldc_startup();
+  s.max_current_ma = 10000;
+  s.open_loop_current_ma = 3000;
+  s.brake_chopper_voltage_v = 52.0;  // the chopper's factory limit (26 V) is below this bus
+  s.current_p = 20;  // current loop at 5000 rad/s
+  s.current_i = 639;
+  s.velocity_p = 13100;
+  s.velocity_i = 6300;
+  s.position_p = 56;
+  m.startup = s;
   return m;
 }
 
@@ -97,10 +116,17 @@ MotorDescription dc_24v() {
   m.hall.present = false;
   m.abn = {true, 2048, 90.0, false};
   m.supply = {24.0, 0.1, 470e-6, 10.0, false};
-  m.startup_parameters = {
-      {10, 1},  {11, 2000}, {14, 1},  {15, 3},  {25, 1},  {70, 768}, {71, 19660},
-      {72, 1200}, {73, 580}, {74, 225}, {100, 2048},
-  };
+  // A DC motor needs no commutation angle; any sensor but "none" switches the bridge on.
+  StartupSettings s;
+  s.max_current_ma = 2000;
+  s.commutation = CommutationSensor::kAbnEncoder;
+  s.position_sensor = PositionSensor::kAbnEncoder;
+  s.current_p = 768;  // current loop at 3000 rad/s
+  s.current_i = 19660;
+  s.velocity_p = 1200;
+  s.velocity_i = 580;
+  s.position_p = 225;
+  m.startup = s;
   return m;
 }
 
@@ -267,19 +293,138 @@ OrderedJson section_json(const Section& section, std::span<const Field<Section>>
   return j;
 }
 
-// The axis parameters must exist, be stored in the EEPROM (E) and be in range.
-std::string check_startup_parameter(int number, int64_t value) {
-  using modules::tmcm1636::Tmcm1636;
-  const auto* row = number >= 0 && number <= 255 ? Tmcm1636::axis_parameters().find(static_cast<uint16_t>(number)) : nullptr;
-  if (row == nullptr) return "axis parameter " + std::to_string(number) + " does not exist";
-  if (!params::has(row->info.access, params::Access::kEeprom)) {
-    return "axis parameter " + std::to_string(number) + " is not stored in the EEPROM";
+// The "startup" section (StartupSettings), key by key in this order; enumerations by name.
+template <typename E>
+struct EnumName {
+  E value;
+  const char* name;
+};
+constexpr EnumName<CommutationSensor> kCommutationNames[] = {
+    {CommutationSensor::kOpenLoop, "open_loop"},
+    {CommutationSensor::kHall, "hall"},
+    {CommutationSensor::kAbnEncoder, "abn_encoder"},
+    {CommutationSensor::kAbsoluteEncoder, "absolute_encoder"},
+};
+constexpr EnumName<PositionSensor> kPositionSensorNames[] = {
+    {PositionSensor::kAbnEncoder, "abn_encoder"},
+    {PositionSensor::kAbsoluteEncoder, "absolute_encoder"},
+};
+constexpr EnumName<EncoderAlignment> kEncoderAlignmentNames[] = {
+    {EncoderAlignment::kEstimateOffset, "estimate_offset"},
+    {EncoderAlignment::kIndexPulse, "index_pulse"},
+    {EncoderAlignment::kHall, "hall"},
+};
+std::span<const EnumName<CommutationSensor>> names_of(CommutationSensor) { return kCommutationNames; }
+std::span<const EnumName<PositionSensor>> names_of(PositionSensor) { return kPositionSensorNames; }
+std::span<const EnumName<EncoderAlignment>> names_of(EncoderAlignment) { return kEncoderAlignmentNames; }
+
+template <typename T>
+using Setting = std::optional<T> StartupSettings::*;
+
+struct StartupField {
+  const char* key;
+  std::variant<Setting<int32_t>, Setting<double>, Setting<bool>, Setting<CommutationSensor>, Setting<PositionSensor>,
+               Setting<EncoderAlignment>>
+      member;
+  double min = 0.0;
+  double max = 0.0;
+};
+
+// Plausible for any motor; the drive's own ranges are checked where the settings are written.
+const StartupField kStartupFields[] = {
+    {"max_current_ma", &StartupSettings::max_current_ma, 0, 1e6},
+    {"open_loop_current_ma", &StartupSettings::open_loop_current_ma, 0, 1e6},
+    {"commutation", &StartupSettings::commutation},
+    {"position_sensor", &StartupSettings::position_sensor},
+    {"hall_interpolation", &StartupSettings::hall_interpolation},
+    {"encoder_alignment", &StartupSettings::encoder_alignment},
+    {"brake_chopper_voltage_v", &StartupSettings::brake_chopper_voltage_v, 0.0, 1000.0},
+    {"current_p", &StartupSettings::current_p, 0, 2147483647.0},
+    {"current_i", &StartupSettings::current_i, 0, 2147483647.0},
+    {"velocity_p", &StartupSettings::velocity_p, 0, 2147483647.0},
+    {"velocity_i", &StartupSettings::velocity_i, 0, 2147483647.0},
+    {"position_p", &StartupSettings::position_p, 0, 2147483647.0},
+};
+
+template <typename E>
+void read_enum(Reader& reader, const char* key, std::optional<E>& out) {
+  std::string name;
+  reader.text(key, name);
+  if (!reader.ok()) return;
+  std::string expected;
+  for (const EnumName<E>& entry : names_of(E{})) {
+    if (name == entry.name) {
+      out = entry.value;
+      return;
+    }
+    expected += std::string(expected.empty() ? "" : ", ") + "\"" + entry.name + "\"";
   }
-  if (value < row->info.min || value > row->info.max) {
-    return "axis parameter " + std::to_string(number) + " takes " + std::to_string(row->info.min) + " to " +
-           std::to_string(row->info.max) + ", got " + std::to_string(value);
+  reader.fail(reader.where(key) + " must be one of " + expected + ", got \"" + name + "\"");
+}
+
+template <typename E>
+const char* enum_name(E value) {
+  for (const EnumName<E>& entry : names_of(E{})) {
+    if (entry.value == value) return entry.name;
   }
-  return {};
+  return "";
+}
+
+// The "startup" object: present (even empty) means the description has start-up settings.
+void read_startup(Reader& parent, std::optional<StartupSettings>& out) {
+  const Json* section = parent.find("startup");
+  if (section == nullptr || !parent.ok()) return;
+  if (!section->is_object()) return parent.fail("startup must be an object");
+  StartupSettings settings;
+  Reader reader{*section, "startup", parent.error};
+  for (const StartupField& field : kStartupFields) {
+    if (!reader.ok()) return;
+    if (!section->contains(field.key)) continue;
+    std::visit(Overloaded{
+                   [&](Setting<int32_t> member) {
+                     int value = 0;
+                     reader.integer(field.key, value, static_cast<int>(field.min), static_cast<int>(field.max));
+                     settings.*member = value;
+                   },
+                   [&](Setting<double> member) {
+                     double value = 0.0;
+                     reader.number(field.key, value, field.min, field.max);
+                     settings.*member = value;
+                   },
+                   [&](Setting<bool> member) {
+                     bool value = false;
+                     reader.flag(field.key, value);
+                     settings.*member = value;
+                   },
+                   [&](auto member) { read_enum(reader, field.key, settings.*member); },
+               },
+               field.member);
+  }
+  if (!reader.ok()) return;
+  reader.finish();
+  out = settings;
+}
+
+OrderedJson startup_json(const StartupSettings& settings) {
+  OrderedJson j = OrderedJson::object();
+  for (const StartupField& field : kStartupFields) {
+    std::visit(Overloaded{
+                   [&](Setting<int32_t> member) {
+                     if (settings.*member) j[field.key] = *(settings.*member);
+                   },
+                   [&](Setting<double> member) {
+                     if (settings.*member) j[field.key] = *(settings.*member);
+                   },
+                   [&](Setting<bool> member) {
+                     if (settings.*member) j[field.key] = *(settings.*member);
+                   },
+                   [&](auto member) {
+                     if (settings.*member) j[field.key] = enum_name(*(settings.*member));
+                   },
+               },
+               field.member);
+  }
+  return j;
 }
 
 }  // namespace
@@ -293,7 +438,8 @@ std::optional<MotorDescription> motor_preset(std::string_view name) {
   return std::nullopt;
 }
 
-MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name) {
+MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name,
+                                        const AxisParameterCheck& check) {
   MotorLoadResult result;
   const std::string prefix = std::string(source_name) + ": ";
   Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
@@ -306,7 +452,6 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
     return result;
   }
   MotorDescription m;
-  m.startup_parameters.clear();
   std::string error;
   Reader top{document, "", error};
   top.text("name", m.name);
@@ -350,6 +495,7 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   read_section<Absolute>(top, "absolute_encoder", m.absolute, kAbsoluteFields);
   read_section<Brake>(top, "brake", m.brake, kBrakeFields);
   read_section<Supply>(top, "supply", m.supply, kSupplyFields);
+  read_startup(top, m.startup);
   if (const Json* parameters = top.find("axis_parameters"); parameters != nullptr && top.ok()) {
     if (!parameters->is_object()) {
       top.fail("axis_parameters must be an object of \"number\": value");
@@ -372,21 +518,27 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
           break;
         }
         const int64_t v = value.get<int64_t>();
-        if (std::string problem = check_startup_parameter(number, v); !problem.empty()) {
+        std::string problem = check ? check(number, v) : std::string();
+        // TMCL parameter numbers are one byte and values 32 bits, whatever the firmware.
+        if (problem.empty() && number > 255) problem = "axis parameter " + std::to_string(number) + " does not exist";
+        if (problem.empty() && (v < std::numeric_limits<int32_t>::min() || v > std::numeric_limits<int32_t>::max())) {
+          problem = "axis parameter " + std::to_string(number) + " takes 32-bit values, got " + std::to_string(v);
+        }
+        if (!problem.empty()) {
           top.fail("axis_parameters: " + problem);
           break;
         }
-        const bool repeated = std::any_of(m.startup_parameters.begin(), m.startup_parameters.end(),
+        const bool repeated = std::any_of(m.axis_parameters.begin(), m.axis_parameters.end(),
                                           [number](const auto& entry) { return entry.first == number; });
         if (repeated) {  // "5" and "05": which one wins would depend on the spelling
           top.fail("axis_parameters: parameter " + std::to_string(number) + " is given twice");
           break;
         }
-        m.startup_parameters.emplace_back(static_cast<uint8_t>(number), static_cast<int32_t>(v));
+        m.axis_parameters.emplace_back(static_cast<uint8_t>(number), static_cast<int32_t>(v));
       }
       // JSON objects have no order (the parser hands keys over sorted as text: "100" before
       // "14"): apply in parameter-number order, so that writing and reading a file keeps it.
-      std::stable_sort(m.startup_parameters.begin(), m.startup_parameters.end(),
+      std::stable_sort(m.axis_parameters.begin(), m.axis_parameters.end(),
                        [](const auto& a, const auto& b) { return a.first < b.first; });
     }
   }
@@ -400,7 +552,7 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   return result;
 }
 
-MotorLoadResult load_motor_description_file(const std::string& path) {
+MotorLoadResult load_motor_description_file(const std::string& path, const AxisParameterCheck& check) {
   std::ifstream file(path);
   if (!file) {
     MotorLoadResult result;
@@ -409,10 +561,10 @@ MotorLoadResult load_motor_description_file(const std::string& path) {
   }
   std::stringstream contents;
   contents << file.rdbuf();
-  return parse_motor_description(contents.str(), path);
+  return parse_motor_description(contents.str(), path, check);
 }
 
-MotorLoadResult resolve_motor(std::string_view name_or_path) {
+MotorLoadResult resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check) {
   MotorLoadResult result;
   if (name_or_path.empty() || name_or_path == "ideal") return result;
   if (std::optional<MotorDescription> preset = motor_preset(name_or_path)) {
@@ -425,7 +577,7 @@ MotorLoadResult resolve_motor(std::string_view name_or_path) {
     result.error = "unknown motor \"" + std::string(name_or_path) + "\" (expected " + names + " or a .json file)";
     return result;
   }
-  return load_motor_description_file(std::string(name_or_path));
+  return load_motor_description_file(std::string(name_or_path), check);
 }
 
 std::string motor_description_json(const MotorDescription& m) {
@@ -445,25 +597,11 @@ std::string motor_description_json(const MotorDescription& m) {
   j["absolute_encoder"] = section_json<Absolute>(m.absolute, kAbsoluteFields);
   j["brake"] = section_json<Brake>(m.brake, kBrakeFields);
   j["supply"] = section_json<Supply>(m.supply, kSupplyFields);
+  if (m.startup) j["startup"] = startup_json(*m.startup);
   OrderedJson parameters = OrderedJson::object();
-  for (const auto& [number, value] : m.startup_parameters) parameters[std::to_string(number)] = value;
+  for (const auto& [number, value] : m.axis_parameters) parameters[std::to_string(number)] = value;
   j["axis_parameters"] = parameters;
   return j.dump(2) + "\n";
-}
-
-void write_startup_parameters(const MotorDescription& motor, uint8_t* image, size_t size) {
-  using modules::tmcm1636::Tmcm1636;
-  if (size < Tmcm1636::kNvmLayout.total_size) return;
-  for (const auto& [number, value] : motor.startup_parameters) {
-    if (!check_startup_parameter(number, value).empty()) continue;
-    tmcl::put_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, number), value);
-  }
-}
-
-bool image_configures_motor(const uint8_t* image, size_t size) {
-  using modules::tmcm1636::Tmcm1636;
-  if (size < Tmcm1636::kNvmLayout.total_size) return false;
-  return tmcl::get_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, 14)) != 0;
 }
 
 }  // namespace motwin::sim

@@ -1,13 +1,20 @@
 // What the simulated TMCM-1636 board drives: a motor (BLDC/PMSM or brushed DC) with its sensors
 // and an optional holding brake, on a supply with its bus capacitance and brake resistor, plus
-// the axis parameters the motor wants at first power-up. Built-in presets (documented with
-// their sources in docs/tmcm-1636-servo.md) and JSON motor description files for users' motors.
+// the settings a drive for this motor starts with. Built-in presets (documented with their
+// sources in docs/tmcm-1636-servo.md) and JSON motor description files for users' motors.
 //
 // Units are SI and in the key names: resistance_ohm, inductance_h, flux_linkage_wb, ...
+//
+// The motor knows nothing of the firmware's parameters or EEPROM layout: its start-up settings
+// are named values, and the host writes them into the firmware's image through the module's
+// parameter table (src/host/modules/tmcm1636/tmcm1636_startup_image.*). A description file may
+// also give firmware axis parameters by number ("axis_parameters"): the motor keeps them as
+// given, and the caller that knows the firmware checks them (AxisParameterCheck).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -17,6 +24,38 @@
 namespace motwin::sim {
 
 enum class MotorKind : uint8_t { kBldc, kDc };
+
+// The sensor the drive commutates on.
+enum class CommutationSensor : uint8_t { kOpenLoop, kHall, kAbnEncoder, kAbsoluteEncoder };
+// The sensor that gives the drive position and velocity.
+enum class PositionSensor : uint8_t { kAbnEncoder, kAbsoluteEncoder };
+// How the drive finds the ABN encoder's offset to the rotor field before it commutates on it:
+// from a short open-loop move, at the N pulse, or from the hall sensors.
+enum class EncoderAlignment : uint8_t { kEstimateOffset, kIndexPulse, kHall };
+
+// The settings a drive for this motor starts with, as a module delivered for the motor holds
+// them in a fresh EEPROM image (docs/tmcm-1636-servo.md, "Presets"). Each is optional: unset, the
+// drive keeps its factory default. With start-up settings the drive is also told the motor's
+// type, pole pairs and ABN encoder resolution, from the description itself.
+struct StartupSettings {
+  std::optional<int32_t> max_current_ma;        // largest phase current the regulators may demand
+  std::optional<int32_t> open_loop_current_ma;  // phase current in open-loop commutation
+  std::optional<CommutationSensor> commutation;
+  std::optional<PositionSensor> position_sensor;
+  std::optional<bool> hall_interpolation;       // the hall angle interpolated between edges
+  std::optional<EncoderAlignment> encoder_alignment;
+  std::optional<double> brake_chopper_voltage_v;  // bus voltage above which the chopper dumps energy
+  // Gains of the drive's regulator cascade, in the TMCM-1636's integer scaling (docs/tmcm-1636-servo.md,
+  // "Gains and units"): current mV = P * e[mA] / 256 + I * sum(e)[mA tick] / 65536, velocity
+  // mA = P * e[rpm] / 256 + I * sum(e)[rpm tick] / 65536, position rpm = P * e[counts] / 256.
+  std::optional<int32_t> current_p;
+  std::optional<int32_t> current_i;
+  std::optional<int32_t> velocity_p;
+  std::optional<int32_t> velocity_i;
+  std::optional<int32_t> position_p;
+
+  bool operator==(const StartupSettings&) const = default;
+};
 
 struct MotorDescription {
   std::string name;
@@ -67,8 +106,11 @@ struct MotorDescription {
     bool regenerative = false;         // a lab supply cannot sink current: regeneration charges the bus
   } supply;
 
-  // Axis parameters written into a fresh EEPROM image (number, value), in parameter-number order.
-  std::vector<std::pair<uint8_t, int32_t>> startup_parameters;
+  // What a drive for this motor starts with (none: a fresh image keeps the factory defaults).
+  std::optional<StartupSettings> startup;
+  // Firmware axis parameters a description file gives by number ("axis_parameters": number,
+  // value), in number order; written into a fresh image after `startup`.
+  std::vector<std::pair<uint8_t, int32_t>> axis_parameters;
 
   // Torque per ampere of q current (BLDC: 1.5 p lambda) or of armature current (DC).
   double torque_constant() const {
@@ -85,19 +127,19 @@ struct MotorLoadResult {
   std::string error;  // "<file>: <what is wrong>" when motor is empty
 };
 
+// Checks one "axis_parameters" entry for the firmware that will get it: empty when it stores
+// parameter `number` and takes `value`, else what is wrong. Without a check, any number 0..255
+// and any 32-bit value is kept.
+using AxisParameterCheck = std::function<std::string(int number, int64_t value)>;
+
 // Parses a JSON motor description (docs/tmcm-1636-servo.md, "Motor description files").
-MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name);
-MotorLoadResult load_motor_description_file(const std::string& path);
+MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name,
+                                        const AxisParameterCheck& check = {});
+MotorLoadResult load_motor_description_file(const std::string& path, const AxisParameterCheck& check = {});
 // A preset name or a file path; "ideal" (or empty) is not a motor and gives an empty result
 // without error.
-MotorLoadResult resolve_motor(std::string_view name_or_path);
+MotorLoadResult resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check = {});
 // The description as JSON (the file format), e.g. to start a file from a preset.
 std::string motor_description_json(const MotorDescription& motor);
-
-// Writes the motor's start-up axis parameters into a TMCM-1636 EEPROM image (after the factory
-// defaults): what a fresh image of a module delivered for this motor holds.
-void write_startup_parameters(const MotorDescription& motor, uint8_t* image, size_t size);
-// Whether a TMCM-1636 image selects a motor (AP 14 != 0).
-bool image_configures_motor(const uint8_t* image, size_t size);
 
 }  // namespace motwin::sim

@@ -1,0 +1,146 @@
+#include "host/modules/tmcm1636/tmcm1636_startup_image.h"
+
+#include <cmath>
+#include <optional>
+
+#include "core/modules/tmcm1636/tmcm1636.h"
+#include "core/tmcl/nvm_layout.h"
+
+namespace motwin::host {
+namespace {
+
+using modules::tmcm1636::Tmcm1636;
+using sim::MotorDescription;
+using sim::StartupSettings;
+
+constexpr uint8_t kMotorTypeParameter = 14;
+
+// Table 11's codes for the named values.
+int32_t motor_type_of(sim::MotorKind kind) { return kind == sim::MotorKind::kDc ? 1 : 3; }  // AP 14
+int32_t commutation_mode_of(sim::CommutationSensor sensor) {                                // AP 15
+  switch (sensor) {
+    case sim::CommutationSensor::kOpenLoop: return 1;
+    case sim::CommutationSensor::kHall: return 2;
+    case sim::CommutationSensor::kAbnEncoder: return 3;
+    case sim::CommutationSensor::kAbsoluteEncoder: return 4;
+  }
+  return 0;
+}
+int32_t position_source_of(sim::PositionSensor sensor) {  // AP 25 (0 = the commutation sensor)
+  return sensor == sim::PositionSensor::kAbsoluteEncoder ? 2 : 1;
+}
+int32_t encoder_init_mode_of(sim::EncoderAlignment alignment) {  // AP 102
+  switch (alignment) {
+    case sim::EncoderAlignment::kEstimateOffset: return 0;
+    case sim::EncoderAlignment::kIndexPulse: return 1;
+    case sim::EncoderAlignment::kHall: return 2;
+  }
+  return 1;
+}
+
+template <class T, class Code>
+std::optional<int32_t> coded(const std::optional<T>& setting, Code code) {
+  if (!setting) return std::nullopt;
+  return code(*setting);
+}
+
+// One named start-up value: its key in the description, the axis parameter of table 11 it goes
+// to, and its value there (none: not set, the factory default stays).
+struct NamedValue {
+  std::string_view key;
+  uint8_t number;
+  std::optional<int32_t> (*value)(const MotorDescription& motor, const StartupSettings& settings);
+};
+
+// In parameter-number order.
+const NamedValue kNamedValues[] = {
+    {"pole_pairs", 10,
+     [](const MotorDescription& m, const StartupSettings&) -> std::optional<int32_t> { return m.pole_pairs; }},
+    {"max_current_ma", 11, [](const MotorDescription&, const StartupSettings& s) { return s.max_current_ma; }},
+    {"open_loop_current_ma", 12, [](const MotorDescription&, const StartupSettings& s) { return s.open_loop_current_ma; }},
+    {"type", kMotorTypeParameter,
+     [](const MotorDescription& m, const StartupSettings&) -> std::optional<int32_t> { return motor_type_of(m.kind); }},
+    {"commutation", 15,
+     [](const MotorDescription&, const StartupSettings& s) { return coded(s.commutation, commutation_mode_of); }},
+    {"position_sensor", 25,
+     [](const MotorDescription&, const StartupSettings& s) { return coded(s.position_sensor, position_source_of); }},
+    {"current_p", 70, [](const MotorDescription&, const StartupSettings& s) { return s.current_p; }},
+    {"current_i", 71, [](const MotorDescription&, const StartupSettings& s) { return s.current_i; }},
+    {"velocity_p", 72, [](const MotorDescription&, const StartupSettings& s) { return s.velocity_p; }},
+    {"velocity_i", 73, [](const MotorDescription&, const StartupSettings& s) { return s.velocity_i; }},
+    {"position_p", 74, [](const MotorDescription&, const StartupSettings& s) { return s.position_p; }},
+    {"hall_interpolation", 92,
+     [](const MotorDescription&, const StartupSettings& s) {
+       return coded(s.hall_interpolation, [](bool on) -> int32_t { return on ? 1 : 0; });
+     }},
+    {"abn_encoder.counts_per_rev", 100,
+     [](const MotorDescription& m, const StartupSettings&) -> std::optional<int32_t> {
+       if (!m.abn.present) return std::nullopt;
+       return m.abn.counts_per_rev;  // AP 100 counts per revolution: the encoder's resolution
+     }},
+    {"encoder_alignment", 102,
+     [](const MotorDescription&, const StartupSettings& s) { return coded(s.encoder_alignment, encoder_init_mode_of); }},
+    {"brake_chopper_voltage_v", 141,
+     [](const MotorDescription&, const StartupSettings& s) {
+       // AP 141 is in 0.1 V.
+       return coded(s.brake_chopper_voltage_v, [](double volt) { return static_cast<int32_t>(std::lround(volt * 10.0)); });
+     }},
+};
+
+}  // namespace
+
+std::vector<Tmcm1636StartupParameter> tmcm1636_startup_parameters(const MotorDescription& motor) {
+  std::vector<Tmcm1636StartupParameter> parameters;
+  if (motor.startup) {
+    for (const NamedValue& named : kNamedValues) {
+      if (const std::optional<int32_t> value = named.value(motor, *motor.startup)) {
+        parameters.push_back({named.number, *value, named.key});
+      }
+    }
+  }
+  for (const auto& [number, value] : motor.axis_parameters) parameters.push_back({number, value, "axis_parameters"});
+  return parameters;
+}
+
+std::string check_tmcm1636_axis_parameter(int number, int64_t value) {
+  const auto* row = number >= 0 && number <= 255 ? Tmcm1636::axis_parameters().find(static_cast<uint16_t>(number)) : nullptr;
+  if (row == nullptr) return "axis parameter " + std::to_string(number) + " does not exist";
+  if (!params::has(row->info.access, params::Access::kEeprom)) {
+    return "axis parameter " + std::to_string(number) + " is not stored in the EEPROM";
+  }
+  if (value < row->info.min || value > row->info.max) {
+    return "axis parameter " + std::to_string(number) + " takes " + std::to_string(row->info.min) + " to " +
+           std::to_string(row->info.max) + ", got " + std::to_string(value);
+  }
+  return {};
+}
+
+sim::MotorLoadResult resolve_tmcm1636_motor(std::string_view name_or_path) {
+  sim::MotorLoadResult result = sim::resolve_motor(name_or_path, check_tmcm1636_axis_parameter);
+  if (!result.motor) return result;
+  // The numbered ones were checked while parsing; the named ones are checked here.
+  for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(*result.motor)) {
+    if (parameter.source == "axis_parameters") continue;
+    if (std::string problem = check_tmcm1636_axis_parameter(parameter.number, parameter.value); !problem.empty()) {
+      result.error = std::string(name_or_path) + ": startup: " + std::string(parameter.source) + ": " + problem;
+      result.motor.reset();
+      return result;
+    }
+  }
+  return result;
+}
+
+void write_tmcm1636_startup_image(const MotorDescription& motor, uint8_t* image, size_t size) {
+  if (size < Tmcm1636::kNvmLayout.total_size) return;
+  for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(motor)) {
+    if (!check_tmcm1636_axis_parameter(parameter.number, parameter.value).empty()) continue;
+    tmcl::put_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, parameter.number), parameter.value);
+  }
+}
+
+bool tmcm1636_image_configures_motor(const uint8_t* image, size_t size) {
+  if (size < Tmcm1636::kNvmLayout.total_size) return false;
+  return tmcl::get_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, kMotorTypeParameter)) != 0;
+}
+
+}  // namespace motwin::host
