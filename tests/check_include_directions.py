@@ -8,7 +8,9 @@ The rules (docs/architecture.md, "Include directions"):
   types/   includes nothing of the project (leaf vocabulary headers, standard library only)
   board/   includes only board/ and types/
   core/    includes only core/, board/ and types/
-  sim/     includes no host/, tools/ or cli/
+  sim/     includes no host/, tools/ or cli/; of a module's core folder only its hardware units
+           (core/modules/<module>/*_hardware.h), not the module profile: the simulated board
+           models the hardware, not the firmware
   host/    includes no tools/ or cli/
   tools/   includes no cli/
   cli/     may include every layer; nothing below it includes cli/
@@ -85,6 +87,12 @@ def check_file(path, src_dir):
                 allowed = ", ".join(sorted(ALLOWED[layer])) or "nothing of the project"
                 violations.append(
                     (number, f'{layer}/ includes "{shown}" ({target_layer}/): {layer}/ may include {allowed}'))
+                continue
+            if layer == "sim" and target_layer == "core" and len(included) >= 4 and included[1] == "modules" \
+                    and not included[-1].endswith("_hardware.h"):
+                violations.append(
+                    (number, f'sim/ includes "{shown}": of core/modules/ the simulation includes only '
+                             "*_hardware.h units (the hardware, not the firmware)"))
                 continue
             target_module = module_of(included)
             if module is not None and target_module is not None and target_module != module:

@@ -23,8 +23,10 @@ CLEAN_TREE = {
     "core/modules/tmcm3216/tmcm3216.h": '#include "core/canopen/pdo.h"\n'
                                         '#include "board/modules/tmcm3216/tmcm3216_board.h"\n',
     "core/modules/tmcm1636/tmcm1636.h": '#include "core/canopen/sdo_abort.h"\n',
-    "sim/modules/tmcm3216/tmcm3216_sim_board.cpp": '#include "core/modules/tmcm3216/tmcm3216.h"\n'
+    "sim/modules/tmcm3216/tmcm3216_sim_board.cpp": '#include "core/modules/tmcm3216/tmcm3216_hardware.h"\n'
+                                                   '#include "core/canopen/sdo_abort.h"\n'
                                                    '#include "sim/stepper_plant.h"\n',
+    "core/modules/tmcm3216/tmcm3216_hardware.h": "#pragma once\n",
     "sim/stepper_plant.h": '#include "board/stepper_drive.h"\n',
     "host/modules/tmcm3216/tmcm3216_virtual_module.cpp": '#include "sim/modules/tmcm3216/tmcm3216_sim_board.cpp"\n',
     "host/module_registry.cpp": '#include "core/modules/tmcm1636/tmcm1636.h"\n'
@@ -92,6 +94,13 @@ class IncludeDirections(unittest.TestCase):
                              '#include "sim/modules/tmcm1636/motor_description.h"\n#include "host/eeprom_file.h"\n',
                              'sim/ includes "host/eeprom_file.h"')
 
+    def test_sim_includes_a_module_profile(self):
+        # The leak issue 15 found: the motor description read the TMCM-1636's parameter table.
+        self.assert_fails_at("sim/modules/tmcm1636/motor_description.cpp", 3,
+                             '#include "sim/modules/tmcm1636/motor_description.h"\n\n'
+                             '#include "core/modules/tmcm1636/tmcm1636.h"\n',
+                             'sim/ includes "core/modules/tmcm1636/tmcm1636.h"')
+
     def test_host_includes_tools(self):
         self.assert_fails_at("host/serve.cpp", 1, '#include "tools/tmcl_client.h"\n', 'host/ includes "tools/tmcl_client.h"')
 
@@ -106,9 +115,12 @@ class IncludeDirections(unittest.TestCase):
                              'board/ includes "core/canopen/sdo_abort.h"')
 
     def test_a_module_includes_another_module(self):
-        self.assert_fails_at("sim/modules/tmcm142/tmcm142_sim_board.cpp", 2,
+        self.assert_fails_at("host/modules/tmcm142/tmcm142_virtual_module.cpp", 2,
                              '#include "core/modules/tmcm142/tmcm142.h"\n#include "core/modules/tmcm3216/tmcm3216.h"\n',
                              "module tmcm142 includes \"core/modules/tmcm3216/tmcm3216.h\" of module tmcm3216")
+        self.assert_fails_at("sim/modules/tmcm142/tmcm142_sim_board.cpp", 2,
+                             '#include "sim/stepper_plant.h"\n#include "sim/modules/tmcm3216/tmcm3216_sim_board.cpp"\n',
+                             "module tmcm142 includes \"sim/modules/tmcm3216/tmcm3216_sim_board.cpp\" of module tmcm3216")
 
     def test_every_violation_is_listed(self):
         files = dict(CLEAN_TREE)
