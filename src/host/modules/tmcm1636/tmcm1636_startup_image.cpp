@@ -87,17 +87,22 @@ const NamedValue kNamedValues[] = {
      }},
 };
 
+// The named start-up values that are set, in parameter-number order.
+std::vector<Tmcm1636StartupParameter> named_parameters(const MotorDescription& motor) {
+  std::vector<Tmcm1636StartupParameter> parameters;
+  if (!motor.startup) return parameters;
+  for (const NamedValue& named : kNamedValues) {
+    if (const std::optional<int32_t> value = named.value(motor, *motor.startup)) {
+      parameters.push_back({named.number, *value, named.key});
+    }
+  }
+  return parameters;
+}
+
 }  // namespace
 
 std::vector<Tmcm1636StartupParameter> tmcm1636_startup_parameters(const MotorDescription& motor) {
-  std::vector<Tmcm1636StartupParameter> parameters;
-  if (motor.startup) {
-    for (const NamedValue& named : kNamedValues) {
-      if (const std::optional<int32_t> value = named.value(motor, *motor.startup)) {
-        parameters.push_back({named.number, *value, named.key});
-      }
-    }
-  }
+  std::vector<Tmcm1636StartupParameter> parameters = named_parameters(motor);
   for (const auto& [number, value] : motor.axis_parameters) parameters.push_back({number, value, "axis_parameters"});
   return parameters;
 }
@@ -119,8 +124,7 @@ sim::MotorLoadResult resolve_tmcm1636_motor(std::string_view name_or_path) {
   sim::MotorLoadResult result = sim::resolve_motor(name_or_path, check_tmcm1636_axis_parameter);
   if (!result.motor) return result;
   // The numbered ones were checked while parsing; the named ones are checked here.
-  for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(*result.motor)) {
-    if (parameter.source == "axis_parameters") continue;
+  for (const Tmcm1636StartupParameter& parameter : named_parameters(*result.motor)) {
     if (std::string problem = check_tmcm1636_axis_parameter(parameter.number, parameter.value); !problem.empty()) {
       result.error = std::string(name_or_path) + ": startup: " + std::string(parameter.source) + ": " + problem;
       result.motor.reset();
