@@ -3,9 +3,24 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "host/module_registry.h"
+
+namespace {
+
+// "TMCM-1636, TMCM-142, ...": every registered module.
+std::string product_names() {
+  std::string names;
+  for (const motwin::host::ModuleDescriptor& module : motwin::host::registered_modules()) {
+    if (!names.empty()) names += ", ";
+    names += module.product_name;
+  }
+  return names;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Motwin: virtual Trinamic motion-control modules (TMCM-1636, TMCM-142, TMCM-3216)"};
+  CLI::App app{"Motwin: virtual Trinamic motion-control modules (" + product_names() + ")"};
   app.require_subcommand(1);
   int exit_status = 0;
   motwin::cli::add_serve_command(app, exit_status);

@@ -1,5 +1,5 @@
-// `motwin params`: lists a module's axis parameters, global parameters and user variables
-// from its declarative tables.
+// `motwin params`: lists a module's parameters (TMCL: axis parameters, global parameters, user
+// variables) or objects (CANopen) from its declarative tables, as its descriptor builds them.
 #include <iostream>
 #include <memory>
 #include <string>
@@ -8,6 +8,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "host/module_registry.h"
 #include "tools/parameter_listing.h"
 
 namespace motwin::cli {
@@ -20,12 +21,12 @@ struct ParamsOptions {
 
 int run_params(const ParamsOptions& options) {
   if (options.module_name.empty()) {
-    print_error(fmt::format("--module is required (known modules: {})", tools::known_module_names()));
+    print_error(fmt::format("--module is required (known modules: {})", host::module_names()));
     return kExitUsageError;
   }
-  const tools::ParameterListingSource* source = tools::find_parameter_listing_source(options.module_name);
-  if (source == nullptr) {
-    print_error(fmt::format("unknown module '{}' (known modules: {})", options.module_name, tools::known_module_names()));
+  const host::ModuleDescriptor* module = host::find_module_ignoring_case(options.module_name);
+  if (module == nullptr) {
+    print_error(fmt::format("unknown module '{}' (known modules: {})", options.module_name, host::module_names()));
     return kExitUsageError;
   }
   const std::optional<tools::ListingFormat> format = tools::parse_listing_format(options.format_name);
@@ -33,7 +34,7 @@ int run_params(const ParamsOptions& options) {
     print_error(fmt::format("unknown format '{}' (expected table, csv or markdown)", options.format_name));
     return kExitUsageError;
   }
-  std::cout << tools::format_parameter_listing(source->build(), *format);
+  std::cout << tools::format_parameter_listing(module->listing(), *format);
   return kExitSuccess;
 }
 
@@ -41,14 +42,18 @@ int run_params(const ParamsOptions& options) {
 
 void add_params_command(CLI::App& app, int& exit_status) {
   auto options = std::make_shared<ParamsOptions>();
-  CLI::App* command =
-      app.add_subcommand("params", "List a module's axis parameters, global parameters and user variables");
-  command->add_option("--module", options->module_name, fmt::format("Module ({})", tools::known_module_names()));
+  CLI::App* command = app.add_subcommand(
+      "params", "List a module's axis parameters, global parameters and user variables, or its CANopen objects");
+  command->add_option("--module", options->module_name, fmt::format("Module ({})", host::module_names()));
   command->add_option("--format", options->format_name, "table, csv or markdown")->capture_default_str();
   command->footer(
       "Examples:\n"
       "  motwin params --module tmcm-1636\n"
-      "  motwin params --module tmcm-1636 --format markdown > docs/tmcm-1636-parameters.md\n");
+      "  motwin params --module tmcm-1636 --format markdown > docs/tmcm-1636-parameters.md\n"
+      "  motwin params --module tmcm-3216 --format csv\n"
+      "\n"
+      "CANopen objects: one row per sub-index, per-axis objects once per axis (docs/canopen.md,\n"
+      "\"Object listing\").\n");
   command->callback([options, &exit_status] { exit_status = run_params(*options); });
 }
 

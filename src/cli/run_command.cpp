@@ -46,7 +46,7 @@ constexpr int kExitProgramFault = 1;
 struct RunOptions {
   std::string program;
   std::vector<std::string> include_dirs;
-  std::string module = "tmcm-1636";
+  std::string module;  // default: the first registered module with TMCL
   std::string duration;
   std::string trace = "trace.csv";
   std::string sample = "1ms";
@@ -154,6 +154,10 @@ int run_run(const RunOptions& options) {
   if (descriptor == nullptr) {
     throw RunError{fmt::format("unknown module \"{}\" (available: {})", options.module, host::module_names())};
   }
+  if (!descriptor->endpoints.has_tmcl()) {
+    throw RunError{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", options.module,
+                               host::module_names(&host::has_tmcl))};
+  }
   const std::optional<uint64_t> duration_us = parse_duration_us(options.duration);
   if (!duration_us) throw RunError{fmt::format("--for {}: expected a duration such as 10s, 500ms or 2.5s", options.duration)};
   const std::optional<uint64_t> sample_us = parse_duration_us(options.sample);
@@ -161,10 +165,9 @@ int run_run(const RunOptions& options) {
     throw RunError{fmt::format("--sample {}: expected a duration such as 1ms, 50us or 0.1s", options.sample)};
   }
   if (options.address && !options.label.empty()) throw RunError{"give at most one of --address and --label"};
-  // Default columns: actual position and velocity (TMCM-1636 AP 52/42, TMCM-142 AP 1/3).
-  const std::string default_params = options.module == "tmcm-142" ? "1,3" : "52,42";
+  // Default columns: the module's actual position and velocity.
   const std::vector<uint8_t> params =
-      parse_numbers(options.params.empty() ? std::vector<std::string>{default_params} : options.params, "--param");
+      options.params.empty() ? descriptor->trace_parameters : parse_numbers(options.params, "--param");
   const std::vector<uint8_t> variables = parse_numbers(options.variables, "--var");
 
   int exit_status = kExitSuccess;
@@ -311,12 +314,22 @@ int run_run(const RunOptions& options) {
 
 void add_run_command(CLI::App& app, int& exit_status) {
   auto options = std::make_shared<RunOptions>();
+  std::string default_columns;  // "52,42 on tmcm-1636, ..."
+  for (const host::ModuleDescriptor& module : host::registered_modules()) {
+    if (module.trace_parameters.empty()) continue;
+    if (!default_columns.empty()) default_columns += ", ";
+    for (size_t i = 0; i < module.trace_parameters.size(); ++i) {
+      default_columns += (i > 0 ? "," : "") + std::to_string(module.trace_parameters[i]);
+    }
+    default_columns += fmt::format(" on {}", module.name);
+  }
+  if (const host::ModuleDescriptor* first = host::first_module(&host::has_tmcl)) options->module = std::string(first->name);
   CLI::App* command = app.add_subcommand(
       "run", "Run a TMCL program headless on an in-process virtual module and write a CSV trace");
   command->add_option("program", options->program, "The .tmc source (or a .bin file from motwin asm)")->required();
   command->add_option("-I,--include-dir", options->include_dirs,
                       "Directory searched for #include files not found next to the including file (repeatable)");
-  command->add_option("--module", options->module, "Module to run: " + host::module_names())
+  command->add_option("--module", options->module, "Module to run: " + host::module_names(&host::has_tmcl))
       ->type_name("NAME")
       ->capture_default_str();
   command->add_option("--for", options->duration, "Simulated time to run: 10s, 500ms, 2.5s, 1min")
@@ -326,7 +339,9 @@ void add_run_command(CLI::App& app, int& exit_status) {
   command->add_option("--sample", options->sample, "Sample period in simulated time (a multiple of the control tick)")
       ->type_name("DURATION")
       ->capture_default_str();
-  command->add_option("--param", options->params, "Axis parameters to trace, as 52,42 (repeatable; default 52,42, on tmcm-142 1,3)")
+  command->add_option("--param", options->params,
+                      "Axis parameters to trace, as 52,42 (repeatable; default actual position and velocity: " +
+                          default_columns + ")")
       ->type_name("N[,N...]");
   command->add_option("--var", options->variables, "User variables (GGP bank 2) to trace, as 0,1 (repeatable)")
       ->type_name("N[,N...]");

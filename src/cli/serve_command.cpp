@@ -44,7 +44,6 @@
 #include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
-#include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
 
@@ -55,7 +54,7 @@ namespace {
 constexpr uint64_t kLagReportIntervalUs = 5'000'000;
 
 struct ServeArguments {
-  std::string module = "tmcm-1636";
+  std::string module;  // default: the first registered module
   std::vector<std::string> tcp_endpoints;
   std::string pty_link;
   std::vector<std::string> can_endpoints;
@@ -207,7 +206,13 @@ int run_serve(const ServeArguments& arguments) {
     can_specs.push_back(*spec);
   }
   options.node_id = static_cast<uint8_t>(arguments.node_id);
-  if (tcp_specs.empty() && arguments.pty_link.empty() && can_specs.empty()) tcp_specs.push_back(host::TcpEndpointSpec{});
+  if (tcp_specs.empty() && arguments.pty_link.empty() && can_specs.empty()) {
+    if (descriptor->endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
+      tcp_specs.push_back(host::TcpEndpointSpec{});  // 127.0.0.1:5000
+    } else {
+      can_specs.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
+    }
+  }
 
   if (arguments.state_dir != host::kNoStateDir) {
     if (!arguments.state_dir.empty()) {
@@ -249,15 +254,15 @@ int run_serve(const ServeArguments& arguments) {
     owned_module = std::move(made.module);
   }
   host::VirtualModule& module = *owned_module;
-  if (group == nullptr && !module.has_tmcl()) {
-    if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty()) {
-      throw ServeError{std::string(module.name()) + " has no TMCL interface (its firmware speaks CANopen): use --can"};
+  if (group == nullptr) {
+    const host::ModuleEndpoints& offered = descriptor->endpoints;
+    if ((!tcp_specs.empty() && !offered.tmcl_tcp) || (!arguments.pty_link.empty() && !offered.tmcl_pty)) {
+      throw ServeError{std::string(module.name()) + " has no TMCL interface" +
+                       (offered.canopen ? " (its firmware speaks CANopen): use --can" : " on TCP or a pty")};
     }
-    tcp_specs.clear();
-    if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
-  }
-  if (group == nullptr && !can_specs.empty() && module.can_node() == nullptr) {
-    throw ServeError{std::string(module.name()) + " has no CAN interface (--can)"};
+    if (!can_specs.empty() && !offered.has_can()) {
+      throw ServeError{std::string(module.name()) + " has no CAN interface (--can)"};
+    }
   }
 
   host::HostRuntime runtime(module, *pacing);
@@ -413,10 +418,71 @@ int run_serve(const ServeArguments& arguments) {
   return kExitSuccess;
 }
 
+// "Endpoints: --tmcl-tcp, ...; default ..." for a module's part of the help.
+std::string endpoints_help(const host::ModuleEndpoints& endpoints) {
+  std::vector<std::string> offered;
+  if (endpoints.tmcl_tcp) offered.push_back("--tmcl-tcp");
+  if (endpoints.tmcl_pty) offered.push_back("--tmcl-pty");
+  if (endpoints.tmcl_can) offered.push_back("--can (TMCL on GP 71/70)");
+  if (endpoints.canopen) offered.push_back("--can (CANopen)");
+  std::string text = "  Endpoints: ";
+  for (size_t i = 0; i < offered.size(); ++i) text += (i > 0 ? ", " : "") + offered[i];
+  text += endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp ? "; default --tmcl-tcp 127.0.0.1:5000\n"
+                                                                        : "; default --can socketcand:127.0.0.1:29536\n";
+  return text;
+}
+
+std::string signals_help(const host::ModuleDescriptor& module) {
+  std::string text = "Signals of " + std::string(module.name) + " (--set, --scenario):\n";
+  for (const sim::SignalInfo& signal : module.input_signals()) {
+    char line[160];
+    const std::string range = signal.whole_numbers_only && signal.min == 0 && signal.max == 1
+                                  ? "0/1"
+                                  : fmt_range(signal.min) + ".." + fmt_range(signal.max);
+    std::snprintf(line, sizeof(line), "  %-9s %-9s %s\n", std::string(signal.name).c_str(), range.c_str(),
+                  std::string(signal.description).c_str());
+    text += line;
+  }
+  return text;
+}
+
+// Each line of a help paragraph, indented.
+std::string indented(std::string_view paragraph, std::string_view indent) {
+  std::string text;
+  while (!paragraph.empty()) {
+    const size_t end = std::min(paragraph.find('\n'), paragraph.size());
+    text += std::string(indent) + std::string(paragraph.substr(0, end)) + "\n";
+    paragraph.remove_prefix(std::min(end + 1, paragraph.size()));
+  }
+  return text;
+}
+
+// The footer's part on the modules: a line each, then each module's help, endpoints, motors and
+// signals, all from the descriptors.
+std::string modules_help() {
+  std::string text = "\nModules (--module, --node):\n";
+  for (const host::ModuleDescriptor& module : host::registered_modules()) {
+    char line[200];
+    std::snprintf(line, sizeof(line), "  %-10s %s\n", std::string(module.name).c_str(), std::string(module.summary).c_str());
+    text += line;
+  }
+  for (const host::ModuleDescriptor& module : host::registered_modules()) {
+    text += "\n" + std::string(module.name) + " (firmware " + std::string(module.firmware) + "):\n";
+    text += indented(module.help, "  ");
+    text += endpoints_help(module.endpoints);
+    std::string motors;
+    for (std::string_view name : module.motors.names()) motors += std::string(name) + "|";
+    text += "  Motors (--motor " + motors + "FILE):\n" + indented(module.motors.help, "    ");
+    text += signals_help(module);
+  }
+  return text;
+}
+
 }  // namespace
 
 void add_serve_command(CLI::App& app, int& exit_status) {
   auto arguments = std::make_shared<ServeArguments>();
+  arguments->module = std::string(host::registered_modules().front().name);
   CLI::App* serve = app.add_subcommand("serve", "Run a virtual module and serve TMCL to host software");
   CLI::Option* module_option =
       serve->add_option("--module", arguments->module, "Module to run: " + host::module_names())
@@ -426,15 +492,15 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "Put several modules on one CAN bus in this process instead of --module: "
                     "MODULE[:KEY=VALUE,...] with keys name (state subdirectory, default MODULE-POSITION), node-id "
                     "and serial (CANopen), motor, receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
-                    "CAN only. Example: --node tmcm-3216:node-id=1 --node tmcm-3216:node-id=2 --node tmcm-1636")
+                    "CAN only (see the examples below)")
       ->type_name("MODULE[:KEY=VALUE,...]")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   serve->add_option("--can-bitrate", arguments->can_bitrate,
                     "Bit rate of the virtual bus (1M, 500k, 125000 ...): each frame occupies it for its bit count "
                     "with stuff bits and is stamped when its last bit is out; a TMCL module whose GP 69 differs is "
-                    "cut off, as is a TMCM-3216 whose active bit rate (2704 at reset, LSS) differs (counted per "
-                    "node in --can-stats). 0: frames take no time")
+                    "cut off, as is a CANopen module whose active bit rate (set at reset or by LSS) differs (counted "
+                    "per node in --can-stats). 0: frames take no time")
       ->type_name("RATE")
       ->capture_default_str();
   serve->add_option("--can-stats", arguments->can_stats_s,
@@ -458,8 +524,13 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "interface='socketcand'), slcan-tcp:[HOST:]PORT (interface='slcan', "
                     "channel='socket://HOST:PORT'), slcan:LINK (an SLCAN adapter on a pseudo-terminal, LINK a "
                     "symbolic link to it) or socketcan:IFACE (a Linux CAN interface such as vcan0); port 0 picks a "
-                    "free port. Repeatable: all share one bus. CANopen modules (tmcm-3216) default to "
-                    "socketcand:127.0.0.1:29536; the TMCM-1636 answers TMCL on GP 71/70. See docs/canopen.md")
+                    "free port. Repeatable: all share one bus. Modules that start on the bus (" +
+                        host::module_names([](const host::ModuleDescriptor& module) {
+                          return module.endpoints.default_endpoint == host::DefaultEndpoint::kCanSocketcand;
+                        }) +
+                        ") default to socketcand:127.0.0.1:29536; TMCL modules (" +
+                        host::module_names([](const host::ModuleDescriptor& module) { return module.endpoints.tmcl_can; }) +
+                        ") answer TMCL on GP 71/70. See docs/canopen.md")
       ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT|slcan:LINK|socketcan:IFACE")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
@@ -469,7 +540,7 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("FILE");
   serve->add_option("--node-id", arguments->node_id,
                     "CANopen node ID as the module's address switches would set it (1..127); without it the "
-                    "stored node ID (object 2705, default 1) applies")
+                    "stored node ID (default 1) applies")
       ->type_name("N")
       ->check(CLI::Range(1, 127));
   serve->add_option("--state-dir", arguments->state_dir,
@@ -486,39 +557,24 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("SIGNAL=VALUE")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  std::string motor_names = "ideal";
-  for (std::string_view preset : sim::motor_preset_names()) motor_names += "|" + std::string(preset);
   serve->add_option("--motor", arguments->motor,
-                    "Motor behind the power stage: ideal (the axis follows its ramp exactly; fast, the default), "
-                    "a preset (default-24v, large-48v, dc-24v: physical models driven by the firmware's "
-                    "regulators; a new EEPROM image gets the preset's start-up settings) or a motor description "
-                    "file (.json). See docs/tmcm-1636-servo.md. The tmcm-142 takes ideal, nema17, nema23 or a stepper "
-                    "description file (docs/tmcm-142.md); the tmcm-3216 takes one of those for all three axes or a "
-                    "comma-separated list, one per axis, e.g. nema17,ideal,nema23 (docs/tmcm-3216-drive.md)")
-      ->type_name(motor_names + "|FILE")
+                    "Motor behind the power stage: ideal (the default; fast), a preset (a physical model) or a "
+                    "description file; each module's choices are listed below")
+      ->type_name("NAME|FILE")
       ->capture_default_str();
   serve->add_option("--scenario", arguments->scenario_path,
                     "Scenario file: lines \"<time_s> <SIGNAL> <value>\" (sim seconds), # comments")
       ->type_name("FILE");
 
-  std::string signals_help;
-  for (const host::ModuleDescriptor& module : host::registered_modules()) {
-    signals_help += "\nSignals of " + std::string(module.name) + " (--set, --scenario):\n";
-    for (const sim::SignalInfo& signal : module.input_signals()) {
-      char line[160];
-      const std::string range = signal.whole_numbers_only && signal.min == 0 && signal.max == 1
-                                    ? "0/1"
-                                    : fmt_range(signal.min) + ".." + fmt_range(signal.max);
-      std::snprintf(line, sizeof(line), "  %-9s %-9s %s\n", std::string(signal.name).c_str(), range.c_str(),
-                    std::string(signal.description).c_str());
-      signals_help += line;
-    }
-  }
   serve->footer(
       "Prints \"motwin: <module> (<firmware>) eeprom <path>\", one \"endpoint ...\" line per endpoint and "
       "\"ready\" on stdout, then \"output GPO0 1 at <sim seconds>\" for each output change. SIGINT or SIGTERM "
-      "stops the server cleanly (exit status 0); a start-up error exits with status 2.\n" +
-      signals_help);
+      "stops the server cleanly (exit status 0); a start-up error exits with status 2.\n"
+      "\n"
+      "Examples:\n"
+      "  motwin serve --module tmcm-142 --tmcl-pty /tmp/tmcm142 --motor nema17\n"
+      "  motwin serve --node tmcm-3216:node-id=1 --node tmcm-3216:node-id=2 --node tmcm-1636\n" +
+      modules_help());
 
   serve->callback([arguments, module_option, &exit_status] {
     arguments->module_given = module_option->count() > 0;

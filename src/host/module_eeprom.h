@@ -11,7 +11,7 @@
 #include "board/non_volatile_memory.h"
 #include "board/ram_non_volatile_memory.h"
 #include "host/eeprom_file.h"
-#include "host/module_registry.h"
+#include "host/module_descriptor.h"
 
 namespace motwin::host {
 

@@ -1,40 +1,70 @@
+// The one row per module. The first row is the default module of `serve` and `run`.
 #include "host/module_registry.h"
 
-#include "host/modules/tmcm142/tmcm142_virtual_module.h"
-#include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
-#include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
-#include "sim/modules/tmcm1636/tmcm1636_sim_board.h"
+#include <cctype>
 
 namespace motwin::host {
+
+// Each module's descriptor, defined in its own folder: src/host/modules/<module>/<module>_descriptor.cpp.
+ModuleDescriptor tmcm1636_descriptor();
+ModuleDescriptor tmcm142_descriptor();
+ModuleDescriptor tmcm3216_descriptor();
+
 namespace {
 
-constexpr ModuleDescriptor kModules[] = {
-    {"tmcm-1636", "TMCM-1636 1-axis BLDC/DC servo module, TMCL firmware 1636V109", &sim::Tmcm1636SimBoard::signal_table,
-     &Tmcm1636VirtualModule::make},
-    {"tmcm-142", "TMCM-142 1-axis stepper module (TMC457: S-ramps, encoder, easyPID), TMCL firmware 142V1.06",
-     &Tmcm142VirtualModule::signal_table, &Tmcm142VirtualModule::make},
-    {"tmcm-3216", "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-402 drive: pp, pv, hm, csp, csv)",
-     &Tmcm3216VirtualModule::signal_table, &Tmcm3216VirtualModule::make},
-};
+bool equals_ignoring_case(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(a[i])) != std::tolower(static_cast<unsigned char>(b[i]))) return false;
+  }
+  return true;
+}
+
+bool any_module(const ModuleDescriptor&) { return true; }
 
 }  // namespace
 
-std::span<const ModuleDescriptor> registered_modules() { return kModules; }
+std::span<const ModuleDescriptor> registered_modules() {
+  // Built on first use: the rows come from other translation units.
+  static const ModuleDescriptor kModules[] = {
+      tmcm1636_descriptor(),
+      tmcm142_descriptor(),
+      tmcm3216_descriptor(),
+  };
+  return kModules;
+}
 
 const ModuleDescriptor* find_module(std::string_view name) {
-  for (const ModuleDescriptor& module : kModules) {
+  for (const ModuleDescriptor& module : registered_modules()) {
     if (module.name == name) return &module;
   }
   return nullptr;
 }
 
-std::string module_names() {
+const ModuleDescriptor* find_module_ignoring_case(std::string_view name) {
+  for (const ModuleDescriptor& module : registered_modules()) {
+    if (equals_ignoring_case(module.name, name)) return &module;
+  }
+  return nullptr;
+}
+
+std::string module_names() { return module_names(&any_module); }
+
+std::string module_names(bool (*keep)(const ModuleDescriptor&)) {
   std::string names;
-  for (const ModuleDescriptor& module : kModules) {
+  for (const ModuleDescriptor& module : registered_modules()) {
+    if (!keep(module)) continue;
     if (!names.empty()) names += ", ";
     names += module.name;
   }
   return names;
+}
+
+const ModuleDescriptor* first_module(bool (*keep)(const ModuleDescriptor&)) {
+  for (const ModuleDescriptor& module : registered_modules()) {
+    if (keep(module)) return &module;
+  }
+  return nullptr;
 }
 
 MakeModuleResult make_module(std::string_view name, const ModuleOptions& options) {

@@ -1,17 +1,22 @@
-// What the TMCL modules on a simulated board (TMCM-1636, TMCM-142) share as virtual modules: the
-// firmware `Device` on the simulated I/O and board, its EEPROM image (a file or memory), TMCL
-// over CAN on GP 71 / GP 70 (core/tmcl/can_link.h) and the tick loop. Each module's make()
-// chooses the motor, opens eeprom_, builds board_, then device_ and can_, in that order.
+// What the TMCL modules on a simulated board share as virtual modules: the firmware `Device` on
+// the simulated I/O and board, its EEPROM image (a file or memory), TMCL over CAN on GP 71 /
+// GP 70 (core/tmcl/can_link.h), the tick loop and the steps of make(). A module is one
+// instantiation (`using Tmcm1636VirtualModule = TmclSimModule<...>`) and its own make(), an
+// explicit specialization in its folder: it chooses the motor, then power_up_on_board() opens
+// eeprom_, builds board_, then device_ and can_, in that order.
 #pragma once
 
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "core/tmcl/engine.h"
 #include "host/board_ticks.h"
+#include "host/module_descriptor.h"
 #include "host/module_eeprom.h"
 #include "host/tmcl_can_node.h"
 #include "host/virtual_module.h"
@@ -20,11 +25,16 @@ namespace motwin::host {
 
 // kTickS is kTickUs in seconds, as the module's firmware spells it (see run_board_ticks).
 template <typename DeviceT, typename SimIo, typename SimBoard, uint32_t kTickUs, double kTickS>
-class TmclSimModule : public VirtualModule {
+class TmclSimModule final : public VirtualModule {
  public:
   using Device = DeviceT;
 
+  // Defined by each module (template <> ... ::make in src/host/modules/<module>/).
+  static MakeModuleResult make(const ModuleOptions& options);
+
   static EepromImageIdentity eeprom_identity() { return eeprom_identity_of<Device>(); }
+  // The inputs `--set` and scenario files address.
+  static std::span<const sim::SignalInfo> signal_table() { return SimBoard::signal_table(); }
 
   TmclSimModule(const TmclSimModule&) = delete;
   TmclSimModule& operator=(const TmclSimModule&) = delete;
@@ -48,8 +58,32 @@ class TmclSimModule : public VirtualModule {
   SimIo& io() { return io_; }
   SimBoard& board() { return *board_; }
 
- protected:
+ private:
   TmclSimModule() = default;
+
+  // make() once the motor is chosen (`motor` empty: the ideal motor): opens the image (a new
+  // one formatted by `format_image`), builds the board on the motor, sets the initial inputs,
+  // lets `build_device` construct device_ (and do what the module needs around it), powers the
+  // firmware up and adds TMCL over CAN. The module, or the error of an unusable image.
+  template <class Motor, class FormatImage, class BuildDevice>
+  static MakeModuleResult power_up_on_board(const ModuleOptions& options, const std::optional<Motor>& motor,
+                                            const FormatImage& format_image, const BuildDevice& build_device) {
+    MakeModuleResult result;
+    std::unique_ptr<TmclSimModule> module(new TmclSimModule());
+    if (!module->eeprom_.open(options, eeprom_identity(), format_image, result.error)) return result;
+    module->board_ = motor ? std::make_unique<SimBoard>(module->io_, *motor) : std::make_unique<SimBoard>(module->io_);
+    for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
+    build_device(*module);
+    module->device_->engine().power_up();
+    module->can_.emplace(module->device_->engine());
+    result.module = std::move(module);
+    return result;
+  }
+  static MakeModuleResult refused(std::string error) {
+    MakeModuleResult result;
+    result.error = std::move(error);
+    return result;
+  }
 
   SimIo io_;
   std::unique_ptr<SimBoard> board_;

@@ -1,82 +1,104 @@
 #include "tools/eds_writer.h"
 
-#include <map>
-#include <memory>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
 
-#include "board/can_controller.h"
-#include "board/ram_non_volatile_memory.h"
-#include "core/canopen/object_dictionary.h"
-#include "core/modules/tmcm3216/tmcm3216.h"
+#include "tools/canopen_object_text.h"
 
 namespace motwin::tools {
 namespace {
 
 using canopen::Access;
-using canopen::DataType;
 using canopen::EntryInfo;
 using canopen::ObjectCode;
+using host::CanopenDictionaryView;
+using host::CanopenIdentity;
+using host::DictionaryEntry;
+using host::DictionaryObject;
 
-std::string_view access_text(Access access) {
-  switch (access) {
-    case Access::kRo: return "ro";
-    case Access::kWo: return "wo";
-    case Access::kRw: return "rw";
-    case Access::kConst: return "const";
-  }
-  return "ro";
-}
-
-// The full range of a numeric type, to leave LowLimit/HighLimit out where they add nothing.
-void type_range(DataType type, int64_t& low, int64_t& high) {
-  const uint8_t bits = static_cast<uint8_t>(canopen::type_size(type) * 8);
-  if (canopen::is_signed(type)) {
-    high = (int64_t{1} << (bits - 1)) - 1;
-    low = -high - 1;
-  } else {
-    low = 0;
-    high = bits >= 64 ? INT64_MAX : (int64_t{1} << bits) - 1;
-  }
-}
-
-std::string number(DataType type, int64_t value) {
-  if (canopen::is_signed(type)) return fmt::format("{}", value);
-  return fmt::format("0x{:X}", static_cast<uint64_t>(value));
-}
-
-class NullCan final : public board::CanController {
+// The EDS text, one line at a time.
+class EdsText {
  public:
-  bool transmit(const can::CanFrame&) override { return true; }
-};
-
-// One object at one index (an axis copy of a row group).
-struct Object {
-  uint16_t index;
-  uint8_t axis;
-  std::vector<size_t> rows;  // sub-index rows, in table order
-};
-
-template <class Owner>
-std::string write_eds(canopen::TableDictionary<Owner>& dictionary, std::string_view product, uint32_t vendor,
-                      uint32_t product_code, uint32_t revision, uint8_t rpdos, uint8_t tpdos,
-                      std::optional<uint8_t> node_id) {
-  const auto rows = dictionary.rows();
-  // Objects in index order; one per axis for strided rows.
-  std::map<uint16_t, Object> objects;
-  for (size_t row = 0; row < rows.size(); ++row) {
-    const EntryInfo& info = rows[row].info;
-    for (uint8_t axis = 0; axis < dictionary.axes_of(info); ++axis) {
-      const uint16_t index = static_cast<uint16_t>(info.index + axis * info.axis_stride);
-      Object& object = objects[index];
-      object.index = index;
-      object.axis = axis;
-      object.rows.push_back(row);
-    }
+  void line(std::string_view text) {
+    text_ += text;
+    text_ += "\n";
   }
+  std::string take() { return std::move(text_); }
+
+ private:
+  std::string text_;
+};
+
+void append_file_info(EdsText& eds, const CanopenIdentity& identity) {
+  eds.line("[FileInfo]");
+  eds.line(fmt::format("FileName={}.eds", identity.product_name));
+  eds.line("FileVersion=1");
+  eds.line("FileRevision=0");
+  eds.line("EDSVersion=4.0");
+  eds.line(fmt::format("Description={} CANopen firmware, written by Motwin from its object table", identity.product_name));
+  // Fixed stamps: the same tables give the same file, byte for byte.
+  eds.line("CreationTime=12:00AM");
+  eds.line("CreationDate=01-01-2025");
+  eds.line("CreatedBy=Motwin");
+  eds.line("ModificationTime=12:00AM");
+  eds.line("ModificationDate=01-01-2025");
+  eds.line("ModifiedBy=Motwin");
+  eds.line("");
+}
+
+bool supports_bit_rate(const CanopenIdentity& identity, uint16_t kbit) {
+  for (const uint16_t rate : identity.bit_rates_kbit) {
+    if (rate == kbit) return true;
+  }
+  return false;
+}
+
+void append_device_info(EdsText& eds, const CanopenIdentity& identity) {
+  eds.line("[DeviceInfo]");
+  eds.line(fmt::format("VendorName={}", identity.vendor_name));
+  eds.line(fmt::format("VendorNumber=0x{:X}", identity.vendor_id));
+  eds.line(fmt::format("ProductName={}", identity.product_name));
+  eds.line(fmt::format("ProductNumber={}", identity.product_code));
+  eds.line(fmt::format("RevisionNumber=0x{:08X}", identity.revision_number));
+  eds.line(fmt::format("OrderCode={}", identity.product_name));
+  // The bit rates CiA-306 has a key for.
+  for (const uint16_t kbit : {10, 20, 50, 125, 250, 500, 800, 1000}) {
+    eds.line(fmt::format("BaudRate_{}={}", kbit, supports_bit_rate(identity, kbit) ? 1 : 0));
+  }
+  eds.line("SimpleBootUpMaster=0");
+  eds.line("SimpleBootUpSlave=1");
+  eds.line("Granularity=8");
+  eds.line("DynamicChannelsSupported=0");
+  eds.line("CompactPDO=0");
+  eds.line("GroupMessaging=0");
+  eds.line(fmt::format("NrOfRXPDO={}", identity.rpdo_count));
+  eds.line(fmt::format("NrOfTXPDO={}", identity.tpdo_count));
+  eds.line(fmt::format("LSS_Supported={}", identity.lss_supported ? 1 : 0));
+  eds.line("");
+  eds.line("[DummyUsage]");
+  for (int i = 1; i <= 7; ++i) eds.line(fmt::format("Dummy000{}={}", i, i >= 2 ? 1 : 0));
+  eds.line("");
+  eds.line("[Comments]");
+  eds.line("Lines=1");
+  eds.line("Line1=Generated by motwin eds; the same tables drive the virtual module's SDO server.");
+  eds.line("");
+}
+
+void append_commissioning(EdsText& eds, const CanopenIdentity& identity, uint8_t node_id) {
+  eds.line("[DeviceComissioning]");
+  eds.line(fmt::format("NodeID={}", node_id));
+  eds.line(fmt::format("NodeName={}", identity.product_name));
+  eds.line("Baudrate=1000");
+  eds.line("");
+}
+
+// [MandatoryObjects], [OptionalObjects], [ManufacturerObjects].
+void append_object_lists(EdsText& eds, const CanopenDictionaryView& dictionary) {
   std::vector<uint16_t> mandatory, optional, manufacturer;
-  for (const auto& [index, object] : objects) {
+  for (const DictionaryObject& object : dictionary.objects) {
+    const uint16_t index = object.index;
     if (index == 0x1000 || index == 0x1001 || index == 0x1018) {
       mandatory.push_back(index);
     } else if (index >= 0x2000 && index <= 0x5FFF) {
@@ -85,136 +107,73 @@ std::string write_eds(canopen::TableDictionary<Owner>& dictionary, std::string_v
       optional.push_back(index);
     }
   }
-
-  std::string out;
-  auto line = [&out](std::string_view text) {
-    out += text;
-    out += "\n";
-  };
-  line("[FileInfo]");
-  line(fmt::format("FileName={}.eds", product));
-  line("FileVersion=1");
-  line("FileRevision=0");
-  line("EDSVersion=4.0");
-  line(fmt::format("Description={} CANopen firmware, written by Motwin from its object table", product));
-  line("CreationTime=12:00AM");
-  line("CreationDate=01-01-2025");
-  line("CreatedBy=Motwin");
-  line("ModificationTime=12:00AM");
-  line("ModificationDate=01-01-2025");
-  line("ModifiedBy=Motwin");
-  line("");
-  line("[DeviceInfo]");
-  line("VendorName=Trinamic Motion Control (Analog Devices)");
-  line(fmt::format("VendorNumber=0x{:X}", vendor));
-  line(fmt::format("ProductName={}", product));
-  line(fmt::format("ProductNumber={}", product_code));
-  line(fmt::format("RevisionNumber=0x{:08X}", revision));
-  line(fmt::format("OrderCode={}", product));
-  // Table 177: 20, 50, 100, 125, 250, 500, 800, 1000 kbit/s.
-  for (const auto& [rate, supported] : std::vector<std::pair<int, int>>{
-           {10, 0}, {20, 1}, {50, 1}, {125, 1}, {250, 1}, {500, 1}, {800, 1}, {1000, 1}}) {
-    line(fmt::format("BaudRate_{}={}", rate, supported));
-  }
-  line("SimpleBootUpMaster=0");
-  line("SimpleBootUpSlave=1");
-  line("Granularity=8");
-  line("DynamicChannelsSupported=0");
-  line("CompactPDO=0");
-  line("GroupMessaging=0");
-  line(fmt::format("NrOfRXPDO={}", rpdos));
-  line(fmt::format("NrOfTXPDO={}", tpdos));
-  line("LSS_Supported=1");  // CiA-305 slave (core/canopen/lss_slave.h)
-  line("");
-  line("[DummyUsage]");
-  for (int i = 1; i <= 7; ++i) line(fmt::format("Dummy000{}={}", i, i >= 2 ? 1 : 0));
-  line("");
-  line("[Comments]");
-  line("Lines=1");
-  line("Line1=Generated by motwin eds; the same tables drive the virtual module's SDO server.");
-  line("");
-  if (node_id) {
-    line("[DeviceComissioning]");
-    line(fmt::format("NodeID={}", *node_id));
-    line(fmt::format("NodeName={}", product));
-    line("Baudrate=1000");
-    line("");
-  }
-  auto list = [&](std::string_view section, const std::vector<uint16_t>& indices) {
-    line(fmt::format("[{}]", section));
-    line(fmt::format("SupportedObjects={}", indices.size()));
-    for (size_t i = 0; i < indices.size(); ++i) line(fmt::format("{}=0x{:04X}", i + 1, indices[i]));
-    line("");
+  const auto list = [&eds](std::string_view section, const std::vector<uint16_t>& indices) {
+    eds.line(fmt::format("[{}]", section));
+    eds.line(fmt::format("SupportedObjects={}", indices.size()));
+    for (size_t i = 0; i < indices.size(); ++i) eds.line(fmt::format("{}=0x{:04X}", i + 1, indices[i]));
+    eds.line("");
   };
   list("MandatoryObjects", mandatory);
   list("OptionalObjects", optional);
   list("ManufacturerObjects", manufacturer);
+}
 
-  auto entry_lines = [&](const EntryInfo& info, uint8_t axis, uint16_t index, std::string_view name) {
-    line(fmt::format("ParameterName={}", name));
-    line("ObjectType=0x7");
-    line(fmt::format("DataType=0x{:04X}", static_cast<unsigned>(info.type)));
-    line(fmt::format("AccessType={}", access_text(info.access)));
-    if (canopen::is_numeric(info.type)) {
-      int64_t low = 0, high = 0;
-      type_range(info.type, low, high);
-      if (info.min != low && info.access != Access::kConst) line(fmt::format("LowLimit={}", number(info.type, info.min)));
-      if (info.max != high && info.access != Access::kConst) line(fmt::format("HighLimit={}", number(info.type, info.max)));
-      const int64_t base = info.axis_default != nullptr ? info.axis_default(axis) : info.default_value;
-      line(info.default_plus_node_id ? fmt::format("DefaultValue=$NODEID+{}", number(info.type, base))
-                                     : fmt::format("DefaultValue={}", number(info.type, base)));
-    } else {
-      canopen::ObjectRef ref;
-      std::string text;
-      if (dictionary.find(index, info.sub, ref) == canopen::SdoAbort::kNone) {
-        uint8_t buffer[256];
-        size_t length = 0;
-        if (dictionary.read(ref, buffer, sizeof(buffer), length) == canopen::SdoAbort::kNone) {
-          text.assign(reinterpret_cast<const char*>(buffer), length);
-        }
-      }
-      line(fmt::format("DefaultValue={}", text));
-    }
-    line(fmt::format("PDOMapping={}", info.pdo_mappable ? 1 : 0));
-  };
-
-  for (const auto& [index, object] : objects) {
-    const EntryInfo& first = rows[object.rows.front()].info;
-    const std::string axis_suffix = object.axis == 0 ? "" : fmt::format(" (motor {})", object.axis);
-    line(fmt::format("[{:04X}]", index));
-    if (first.code == ObjectCode::kVar) {
-      entry_lines(first, object.axis, index, std::string(first.object_name) + axis_suffix);
-      line("");
-      continue;
-    }
-    line(fmt::format("ParameterName={}{}", first.object_name, axis_suffix));
-    line(fmt::format("ObjectType=0x{:X}", static_cast<unsigned>(first.code)));
-    line(fmt::format("SubNumber={}", object.rows.size()));
-    line("");
-    for (const size_t row : object.rows) {
-      const EntryInfo& info = rows[row].info;
-      line(fmt::format("[{:04X}sub{:X}]", index, info.sub));
-      entry_lines(info, object.axis, index, info.name);
-      line("");
-    }
+// The keys of one VAR or sub-index, from ParameterName to PDOMapping. LowLimit/HighLimit only
+// where the range is narrower than the type's.
+void append_entry(EdsText& eds, const DictionaryEntry& entry, std::string_view name) {
+  const EntryInfo& info = entry.info;
+  eds.line(fmt::format("ParameterName={}", name));
+  eds.line("ObjectType=0x7");
+  eds.line(fmt::format("DataType=0x{:04X}", static_cast<unsigned>(info.type)));
+  eds.line(fmt::format("AccessType={}", access_text(info.access)));
+  if (canopen::is_numeric(info.type)) {
+    int64_t low = 0, high = 0;
+    type_range(info.type, low, high);
+    if (info.min != low && info.access != Access::kConst) eds.line(fmt::format("LowLimit={}", number_text(info.type, info.min)));
+    if (info.max != high && info.access != Access::kConst) eds.line(fmt::format("HighLimit={}", number_text(info.type, info.max)));
   }
-  return out;
+  eds.line(fmt::format("DefaultValue={}", default_text(entry)));
+  eds.line(fmt::format("PDOMapping={}", info.pdo_mappable ? 1 : 0));
+}
+
+// [IIII] with its entry keys for a VAR; otherwise [IIII] with the object's keys and one
+// [IIIIsubS] section per sub-index.
+void append_object(EdsText& eds, const DictionaryObject& object) {
+  const EntryInfo& first = object.entries.front().info;
+  const std::string axis_suffix = object.axis == 0 ? "" : fmt::format(" (motor {})", object.axis);
+  eds.line(fmt::format("[{:04X}]", object.index));
+  if (first.code == ObjectCode::kVar) {
+    append_entry(eds, object.entries.front(), std::string(first.object_name) + axis_suffix);
+    eds.line("");
+    return;
+  }
+  eds.line(fmt::format("ParameterName={}{}", first.object_name, axis_suffix));
+  eds.line(fmt::format("ObjectType=0x{:X}", static_cast<unsigned>(first.code)));
+  eds.line(fmt::format("SubNumber={}", object.entries.size()));
+  eds.line("");
+  for (const DictionaryEntry& entry : object.entries) {
+    eds.line(fmt::format("[{:04X}sub{:X}]", object.index, entry.info.sub));
+    append_entry(eds, entry, entry.info.name);
+    eds.line("");
+  }
 }
 
 }  // namespace
 
-std::optional<std::string> write_module_eds(std::string_view module_name, std::optional<uint8_t> node_id) {
-  using Device = modules::tmcm3216::Tmcm3216;
-  if (module_name != Device::kName) return std::nullopt;
-  // A device on a RAM image: the visible strings and the table come from the real profile.
-  auto nvm = std::make_unique<board::RamNonVolatileMemory<Device::kNvmSize>>();
-  Device::format_factory_image(nvm->mutable_data(), nvm->size());
-  NullCan can;
-  auto device = std::make_unique<Device>(*nvm, can);
-  device->power_up();
-  constexpr uint8_t kPdos = modules::tmcm3216::kAxisCount * modules::tmcm3216::kPdosPerAxis;
-  return write_eds(device->dictionary(), "TMCM-3216", Device::kVendorId, Device::kProductCode, Device::kRevisionNumber,
-                   kPdos, kPdos, node_id);
+std::string write_eds(const CanopenIdentity& identity, const CanopenDictionaryView& dictionary,
+                      std::optional<uint8_t> node_id) {
+  EdsText eds;
+  append_file_info(eds, identity);
+  append_device_info(eds, identity);
+  if (node_id) append_commissioning(eds, identity, *node_id);
+  append_object_lists(eds, dictionary);
+  for (const DictionaryObject& object : dictionary.objects) append_object(eds, object);
+  return eds.take();
+}
+
+std::optional<std::string> write_module_eds(const host::ModuleDescriptor& module, std::optional<uint8_t> node_id) {
+  if (module.canopen == nullptr) return std::nullopt;
+  return write_eds(module.canopen->identity, module.canopen->dictionary(), node_id);
 }
 
 }  // namespace motwin::tools

@@ -165,7 +165,7 @@ TEST(CliParams, lists_tmcm1636_parameters_in_each_format) {
 TEST(CliParams, unknown_module_or_format_exits_2) {
   const CompletedProcess module = run_motwin({"params", "--module", "tmcm-9999"});
   EXPECT_EQ(module.exit_status, 2);
-  EXPECT_EQ(module.output, "motwin: error: unknown module 'tmcm-9999' (known modules: tmcm-1636, tmcm-142)\n");
+  EXPECT_EQ(module.output, "motwin: error: unknown module 'tmcm-9999' (known modules: tmcm-1636, tmcm-142, tmcm-3216)\n");
   const CompletedProcess format = run_motwin({"params", "--module", "tmcm-1636", "--format", "json"});
   EXPECT_EQ(format.exit_status, 2);
   EXPECT_TRUE(contains(format.output, "unknown format 'json'"));

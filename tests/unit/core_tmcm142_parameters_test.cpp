@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/modules/tmcm142/tmcm142_hardware.h"
+#include "host/module_registry.h"
 #include "support/tmcm142_rig.h"
 #include "tools/parameter_listing.h"
 #include "support/tmcm1636_rig.h"
@@ -57,9 +58,9 @@ TEST(Tmcm142Parameters, motwin_decisions_are_tagged) {
 }
 
 TEST(Tmcm142Parameters, motwin_params_lists_the_table_with_the_decisions_marked) {
-  const tools::ParameterListingSource* source = tools::find_parameter_listing_source("tmcm-142");
+  const host::ModuleDescriptor* source = host::find_module_ignoring_case("tmcm-142");
   ASSERT_NE(source, nullptr);
-  const tools::ModuleParameterListing listing = source->build();
+  const host::ModuleParameterListing listing = source->listing();
   ASSERT_EQ(listing.sections.size(), 3u);
   const std::string table = tools::format_parameter_listing(listing, tools::ListingFormat::kTable);
   EXPECT_NE(table.find("[Motwin decision] jerk building up the acceleration"), std::string::npos);

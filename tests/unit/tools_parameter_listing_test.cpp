@@ -5,9 +5,15 @@
 #include <string>
 
 #include "core/modules/tmcm1636/tmcm1636.h"
+#include "host/module_registry.h"
 
 namespace motwin::tools {
 namespace {
+
+using host::ListedParameter;
+using host::ModuleParameterListing;
+using host::ParameterKind;
+using host::ParameterSection;
 
 const ListedParameter* find_parameter(const ModuleParameterListing& listing, ParameterKind kind,
                                       std::optional<uint8_t> bank, uint16_t number) {
@@ -21,9 +27,9 @@ const ListedParameter* find_parameter(const ModuleParameterListing& listing, Par
 }
 
 ModuleParameterListing tmcm1636_listing() {
-  const ParameterListingSource* source = find_parameter_listing_source("tmcm-1636");
+  const host::ModuleDescriptor* source = host::find_module_ignoring_case("tmcm-1636");
   EXPECT_NE(source, nullptr);
-  return source != nullptr ? source->build() : ModuleParameterListing{};
+  return source != nullptr ? source->listing() : ModuleParameterListing{};
 }
 
 TEST(ParameterListing, tmcm1636_max_velocity_row_comes_from_the_module_table) {
@@ -79,12 +85,13 @@ TEST(ParameterListing, csv_quotes_fields_with_commas_and_markdown_escapes_pipes)
 }
 
 TEST(ParameterListing, module_names_and_formats_are_looked_up_case_insensitively) {
-  EXPECT_NE(find_parameter_listing_source("TMCM-1636"), nullptr);
-  EXPECT_EQ(find_parameter_listing_source("tmcm-9999"), nullptr);
+  EXPECT_NE(host::find_module_ignoring_case("TMCM-1636"), nullptr);
+  EXPECT_EQ(host::find_module_ignoring_case("tmcm-9999"), nullptr);
   EXPECT_EQ(parse_listing_format("CSV"), ListingFormat::kCsv);
   EXPECT_EQ(parse_listing_format("markdown"), ListingFormat::kMarkdown);
   EXPECT_FALSE(parse_listing_format("json"));
-  EXPECT_EQ(known_module_names(), "tmcm-1636, tmcm-142");
+  // `motwin params` now also lists the TMCM-3216's objects.
+  EXPECT_EQ(host::module_names(), "tmcm-1636, tmcm-142, tmcm-3216");
 }
 
 }  // namespace

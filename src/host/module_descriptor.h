@@ -1,0 +1,109 @@
+// Everything the host runtime, the CLI and the tools know about a module, in one place: its
+// names, firmware identity, input signals, make(), endpoints, motors, help, parameter or object
+// listing and, for a CANopen module, what its EDS says. Each module defines its descriptor in its
+// own folder (src/host/modules/<module>/<module>_descriptor.cpp); host/module_registry.cpp lists
+// them, one row each. Nothing outside those files names a module (docs/host-runtime.md, "Adding
+// a module"; tests/unit/host_module_descriptor_test.cpp checks both).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "host/canopen_dictionary_view.h"
+#include "host/eeprom_file.h"
+#include "host/module_listing.h"
+#include "host/virtual_module.h"
+#include "sim/signals.h"
+
+namespace motwin::host {
+
+struct InitialInput {
+  std::string signal;
+  double value;
+};
+
+struct ModuleOptions {
+  // Directory of the EEPROM image file; nullopt keeps the image in memory (factory defaults).
+  std::optional<std::filesystem::path> state_dir;
+  // Input levels set before power-up (`--set`), already checked against input_signals.
+  std::vector<InitialInput> initial_inputs;
+  // The motor: "ideal" or empty (the axis follows its ramp exactly, the default), or one of the
+  // module's MotorChoices (a preset name or a motor description file).
+  std::string motor;
+  // CANopen node ID as address switches would set it (`--node-id`, 1..127); 0: the stored one.
+  uint8_t node_id = 0;
+  // CANopen identity 1018 sub 4; 0: the module's default (1). Distinct serials tell two
+  // unconfigured modules apart in an LSS fastscan.
+  uint32_t serial_number = 0;
+  LogSink log = log_to_stderr;
+};
+
+struct MakeModuleResult {
+  std::unique_ptr<VirtualModule> module;  // powered up and ready for its first tick
+  std::string error;                      // when module is null
+};
+
+// Where `motwin serve` puts a module when no endpoint option is given.
+enum class DefaultEndpoint : uint8_t {
+  kTmclTcp,        // TMCL over TCP on 127.0.0.1:5000
+  kCanSocketcand,  // the CAN bus as a socketcand server on 127.0.0.1:29536
+};
+
+// The endpoints a module offers (`motwin serve`, docs/host-runtime.md).
+struct ModuleEndpoints {
+  bool tmcl_tcp = false;  // --tmcl-tcp
+  bool tmcl_pty = false;  // --tmcl-pty: a serial port (TMCL binary, and ASCII where the firmware has it)
+  bool tmcl_can = false;  // --can: TMCL over CAN (GP 71/70)
+  bool canopen = false;   // --can: a CANopen node (`motwin sdo`, `motwin eds`)
+  DefaultEndpoint default_endpoint = DefaultEndpoint::kTmclTcp;
+
+  // A TMCL engine: `motwin run`, `motwin tmcl`.
+  bool has_tmcl() const { return tmcl_tcp || tmcl_pty || tmcl_can; }
+  bool has_can() const { return tmcl_can || canopen; }
+};
+
+// What `--motor` takes for a module besides a motor description file.
+struct MotorChoices {
+  // "ideal" first (the default), then the presets.
+  std::vector<std::string_view> (*names)();
+  std::string_view help;  // a paragraph for `serve --help`: what a preset is, the file format, per-axis lists
+};
+
+// "ideal" followed by a simulation's preset names: MotorChoices::names of most modules.
+inline std::vector<std::string_view> ideal_and(std::vector<std::string_view> presets) {
+  presets.insert(presets.begin(), "ideal");
+  return presets;
+}
+
+// The EDS of a CANopen module: its identity and its objects at factory defaults.
+struct CanopenDescription {
+  CanopenIdentity identity;
+  CanopenDictionaryView (*dictionary)();
+};
+
+struct ModuleDescriptor {
+  std::string_view name;          // as --module takes it: "tmcm-1636"
+  std::string_view product_name;  // as the manuals write it: "TMCM-1636"
+  std::string_view summary;       // one line for --help
+  std::string_view firmware;      // as `serve` prints it: "1636V109"
+  std::string_view help;          // a paragraph for `serve --help`
+  std::span<const sim::SignalInfo> (*input_signals)();
+  MakeModuleResult (*make)(const ModuleOptions& options);
+  ModuleEndpoints endpoints;
+  // The axis parameters `motwin run` traces by default (actual position and velocity); empty
+  // for a module without TMCL.
+  std::vector<uint8_t> trace_parameters = {};
+  MotorChoices motors;
+  // `motwin params`: the parameters of a TMCL module or the objects of a CANopen module.
+  ModuleParameterListing (*listing)();
+  // nullptr: no CANopen object dictionary (`motwin eds` refuses the module).
+  const CanopenDescription* canopen = nullptr;
+};
+
+}  // namespace motwin::host
