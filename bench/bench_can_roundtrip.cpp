@@ -107,8 +107,7 @@ class BareSocketcandEcho {
           write_all("< ok >");
           continue;
         }
-        std::string error;
-        std::optional<can::CanFrame> frame = host::parse_socketcand_send(words, error);
+        Result<can::CanFrame> frame = host::parse_socketcand_send(words);
         if (!frame) continue;
         frame->id -= 0x80;
         write_all(host::format_socketcand_frame(*frame, 0));
@@ -194,9 +193,9 @@ int main(int argc, char** argv) {
     motwin_path = *found;
   }
 
-  tools::Result<tools::TemporaryDirectory> state_dir = tools::TemporaryDirectory::create("motwin-bench-");
+  Result<tools::TemporaryDirectory> state_dir = tools::TemporaryDirectory::create("motwin-bench-");
   if (!state_dir) return fail(state_dir.error());
-  tools::Result<tools::RunningServe> serve = tools::start_serve(
+  Result<tools::RunningServe> serve = tools::start_serve(
       motwin_path, {"--node", "tmcm-3216:node-id=1", "--node", "tmcm-1636", "--can", "socketcand:127.0.0.1:0",
                     "--state-dir", state_dir->path().string(), "--speed", "realtime"});
   if (!serve) return fail(serve.error());
@@ -206,10 +205,12 @@ int main(int argc, char** argv) {
 
   BareSocketcandEcho bare;
   if (!bare.start()) return fail("cannot start the bare socketcand server");
-  tools::SocketcandClient::OpenResult serve_bus = tools::SocketcandClient::connect("127.0.0.1", serve_port);
-  if (!serve_bus.client) return fail(serve_bus.error);
-  tools::SocketcandClient::OpenResult bare_bus = tools::SocketcandClient::connect("127.0.0.1", bare.port());
-  if (!bare_bus.client) return fail(bare_bus.error);
+  Result<std::unique_ptr<tools::SocketcandClient>> serve_bus =
+      tools::SocketcandClient::connect("127.0.0.1", serve_port);
+  if (!serve_bus) return fail(serve_bus.error());
+  Result<std::unique_ptr<tools::SocketcandClient>> bare_bus =
+      tools::SocketcandClient::connect("127.0.0.1", bare.port());
+  if (!bare_bus) return fail(bare_bus.error());
 
   struct Series {
     const char* name;
@@ -217,9 +218,9 @@ int main(int argc, char** argv) {
     std::vector<nanoseconds> samples;
   };
   std::vector<Series> series;
-  series.push_back({"bare socketcand echo (in process)", sdo_round_trip(*bare_bus.client), {}});
-  series.push_back({"motwin SDO upload, TMCM-3216", sdo_round_trip(*serve_bus.client), {}});
-  series.push_back({"motwin TMCL GAP over CAN, TMCM-1636", tmcl_round_trip(*serve_bus.client), {}});
+  series.push_back({"bare socketcand echo (in process)", sdo_round_trip(**bare_bus), {}});
+  series.push_back({"motwin SDO upload, TMCM-3216", sdo_round_trip(**serve_bus), {}});
+  series.push_back({"motwin TMCL GAP over CAN, TMCM-1636", tmcl_round_trip(**serve_bus), {}});
   for (Series& s : series) {
     for (size_t i = 0; i < kWarmupRequests; ++i) {
       if (!s.round_trip()) return fail(std::string(s.name) + ": no answer during warm-up");

@@ -96,7 +96,7 @@ std::optional<Options> parse_options(int argc, char** argv) {
 // One timed GAP round trip; std::nullopt (and a message) when the request failed.
 std::optional<nanoseconds> timed_round_trip(tools::TmclClient& client, const tmcl::Instruction& request) {
   const auto start = std::chrono::steady_clock::now();
-  const tools::Result<tools::TmclReply> reply = client.request(request);
+  const Result<tools::TmclReply> reply = client.request(request);
   const auto elapsed = std::chrono::steady_clock::now() - start;
   if (!reply || reply->status != 100) {
     std::fprintf(stderr, "bench_tcp_roundtrip: %s: %s\n", client.peer_name().c_str(),
@@ -182,9 +182,9 @@ int main(int argc, char** argv) {
     return fail("usage: bench_tcp_roundtrip [PATH/TO/motwin] [--requests N] (motwin not found next to this program?)");
   }
 
-  tools::Result<tools::TemporaryDirectory> state_dir = tools::TemporaryDirectory::create("motwin-bench-");
+  Result<tools::TemporaryDirectory> state_dir = tools::TemporaryDirectory::create("motwin-bench-");
   if (!state_dir) return fail(state_dir.error());
-  tools::Result<tools::RunningServe> serve =
+  Result<tools::RunningServe> serve =
       tools::start_serve(options->motwin_path, {"--module", "tmcm-1636", "--tmcl-tcp", "127.0.0.1:0", "--state-dir",
                                                 state_dir->path().string(), "--speed", "realtime"});
   if (!serve) return fail(serve.error());
@@ -192,23 +192,23 @@ int main(int argc, char** argv) {
   if (!serve_address) return fail("`motwin serve` printed no `endpoint tmcl-tcp` line");
 
   // The bare server answers with a well-formed reply so that both go through the same client.
-  tools::Result<std::unique_ptr<tools::LoopbackFrameServer>> bare_server =
+  Result<std::unique_ptr<tools::LoopbackFrameServer>> bare_server =
       tools::LoopbackFrameServer::start([](const tmcl::Frame& request, tmcl::Frame& reply) {
         reply = tmcl::encode_reply(2, request[0], tmcl::Reply{100, request[1], 0});
         return tmcl::kFrameLength;
       });
   if (!bare_server) return fail(bare_server.error());
 
-  tools::Result<tools::TmclClient> serve_client = tools::TmclClient::connect_tcp(*serve_address);
+  Result<tools::TmclClient> serve_client = tools::TmclClient::connect_tcp(*serve_address);
   if (!serve_client) return fail(serve_client.error());
-  tools::Result<tools::TmclClient> bare_client = tools::TmclClient::connect_tcp(bare_server.value()->address());
+  Result<tools::TmclClient> bare_client = tools::TmclClient::connect_tcp(bare_server.value()->address());
   if (!bare_client) return fail(bare_client.error());
 
   // Under a flood a reply may wait behind every other connection's queued requests.
   serve_client->set_reply_timeout(std::chrono::seconds(10));
   std::vector<FloodConnection> flooders(options->flooders);
   for (FloodConnection& flooder : flooders) {
-    tools::Result<tools::UniqueFd> fd = tools::connect_tcp_socket(*serve_address, std::chrono::seconds(5));
+    Result<tools::UniqueFd> fd = tools::connect_tcp_socket(*serve_address, std::chrono::seconds(5));
     if (!fd) return fail(fd.error());
     flooder.fd = std::move(fd.value());
   }

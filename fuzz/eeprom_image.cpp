@@ -60,12 +60,12 @@ void load(const std::vector<uint8_t>& bytes) {
     file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
 
-  const std::string problem = host::EepromFile::validate(identity, bytes);
+  const std::string problem = host::EepromFile::validate(identity, bytes).error();
   std::vector<std::string> log;
   auto opened = host::EepromFile::open(state_dir, identity, &Device::format_factory_image,
                                        [&log](const std::string& line) { log.push_back(line); });
-  FUZZ_CHECK(opened.file != nullptr, "%s: open failed: %s", identity.module_name.c_str(), opened.error.c_str());
-  const host::EepromFile& file = *opened.file;
+  FUZZ_CHECK(opened.ok(), "%s: open failed: %s", identity.module_name.c_str(), opened.error().c_str());
+  const host::EepromFile& file = **opened;
   if (problem.empty()) {
     FUZZ_CHECK(file.load_outcome() == host::EepromLoadOutcome::kLoaded, "a valid image was not loaded");
     FUZZ_CHECK(log.empty(), "a valid image was reported: %s", log.front().c_str());
@@ -78,12 +78,12 @@ void load(const std::vector<uint8_t>& bytes) {
                log.size());
     FUZZ_CHECK(read_all(image.string() + ".damaged") == bytes, "the damaged bytes were not kept as they were");
     const std::vector<uint8_t> replaced = read_all(image);
-    FUZZ_CHECK(host::EepromFile::validate(identity, replaced).empty(), "the replacement image is not valid");
+    FUZZ_CHECK(host::EepromFile::validate(identity, replaced).ok(), "the replacement image is not valid");
     std::vector<uint8_t> factory(identity.payload_size);
     Device::format_factory_image(factory.data(), factory.size());
     FUZZ_CHECK(host::EepromFile::encode(identity, factory.data()) == replaced, "the replacement is not the factory image");
   }
-  opened.file.reset();
+  opened->reset();
   fs::remove_all(state_dir, ignored);
 }
 

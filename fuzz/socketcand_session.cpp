@@ -109,11 +109,10 @@ class Model {
       return;
     }
     if (command == "send") {
-      std::string problem;
-      if (const std::optional<can::CanFrame> frame = host::parse_socketcand_send(words, problem)) {
+      if (const Result<can::CanFrame> frame = host::parse_socketcand_send(words)) {
         events.emplace_back(*frame);
       } else {
-        write(" < error " + problem + " >");
+        write(" < error " + frame.error() + " >");
       }
     } else if (command == "rawmode" && alone) {
       const bool entering = mode != Mode::kRaw;

@@ -76,17 +76,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(element.size() <= host::SocketcandElementParser::kMaxElementLength, "element of %zu bytes",
                element.size());
     FUZZ_CHECK(element.find_first_of("<>") == std::string::npos, "element '%s' holds a bracket", element.c_str());
-    std::string error;
-    const auto frame = host::parse_socketcand_send(host::socketcand_words(element), error);
+    const auto frame = host::parse_socketcand_send(host::socketcand_words(element));
     if (!frame) {
-      FUZZ_CHECK(!error.empty(), "'%s' refused without a reason", element.c_str());
+      FUZZ_CHECK(!frame.error().empty(), "'%s' refused without a reason", element.c_str());
       continue;
     }
     FUZZ_CHECK(frame->dlc <= can::kMaxDataLength && !frame->rtr, "'%s': dlc %u", element.c_str(), frame->dlc);
     FUZZ_CHECK(frame->id <= (frame->extended ? can::kMaxExtendedId : can::kMaxStandardId), "'%s': ID %x",
                element.c_str(), frame->id);
     const std::string again_text = send_element(*frame);
-    const auto again = host::parse_socketcand_send(host::socketcand_words(again_text), error);
+    const auto again = host::parse_socketcand_send(host::socketcand_words(again_text));
     FUZZ_CHECK(again && *again == *frame && again->extended == frame->extended,
                "'%s' written back as '%s' does not parse to the same frame", element.c_str(), again_text.c_str());
     check_frame_element(*frame);

@@ -60,7 +60,7 @@ int run_asm(const AsmOptions& options) {
     print_error(fmt::format("the output {} would overwrite the source; give another name with -o", output));
     return kExitUsageError;
   }
-  const tools::Result<size_t> written = tools::write_program_binary(output, result.instructions);
+  const Result<size_t> written = tools::write_program_binary(output, result.instructions);
   if (!written) {
     print_error(written.error());
     return kExitUsageError;

@@ -215,11 +215,9 @@ void add_lss_command(CLI::App& app, int& exit_status) {
       ->capture_default_str();
   fastscan->callback([options, &exit_status] {
     with_master(*options, exit_status, [&](tools::LssMaster& master) {
-      std::string error;
-      const std::optional<tools::LssIdentityNumbers> found =
-          master.fastscan(static_cast<int>(options->step_timeout_s * 1000), error);
+      const Result<tools::LssIdentityNumbers> found = master.fastscan(static_cast<int>(options->step_timeout_s * 1000));
       if (!found) {
-        print_error(error);
+        print_error(found.error());
         return kExitModuleError;
       }
       std::cout << "vendor " << hex32(found->vendor_id) << " product " << hex32(found->product_code) << " revision "

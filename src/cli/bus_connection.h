@@ -3,7 +3,6 @@
 #pragma once
 
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "cli/cli_errors.h"
@@ -16,19 +15,20 @@ inline constexpr const char* kDefaultCanEndpoint = "socketcand:127.0.0.1:29536";
 
 // Connects and enters raw mode; nullptr after printing the error (exit_status = 2).
 inline std::unique_ptr<tools::SocketcandClient> connect_can(const std::string& endpoint, int& exit_status) {
-  std::string error;
-  const std::optional<host::CanEndpointSpec> spec = host::parse_can_endpoint(endpoint, error);
+  const Result<host::CanEndpointSpec> spec = host::parse_can_endpoint(endpoint);
   if (!spec || spec->transport != host::CanTransport::kSocketcand) {
-    print_error("--can: " + (spec ? std::string("only socketcand endpoints are supported here") : error));
+    print_error("--can: " + (spec ? std::string("only socketcand endpoints are supported here") : spec.error()));
     exit_status = kExitUsageError;
     return nullptr;
   }
-  tools::SocketcandClient::OpenResult opened = tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
-  if (!opened.client) {
-    print_error(opened.error);
+  Result<std::unique_ptr<tools::SocketcandClient>> opened =
+      tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
+  if (!opened) {
+    print_error(opened.error());
     exit_status = kExitUsageError;
+    return nullptr;
   }
-  return std::move(opened.client);
+  return std::move(*opened);
 }
 
 }  // namespace motwin::cli

@@ -34,12 +34,12 @@ struct DisasmOptions {
   bool keep_final_stop = false;
 };
 
-tools::Result<std::vector<tmcl::Instruction>> read_from_module(const DisasmOptions& options) {
-  tools::Result<tools::TmclClient> client =
+Result<std::vector<tmcl::Instruction>> read_from_module(const DisasmOptions& options) {
+  Result<tools::TmclClient> client =
       options.tcp_address.empty()
           ? tools::TmclClient::open_serial(options.serial_device)
           : tools::TmclClient::connect_tcp(options.tcp_address, std::chrono::milliseconds(options.timeout_ms));
-  if (!client) return tools::Error{client.error()};
+  if (!client) return Error{client.error()};
   client->set_reply_timeout(std::chrono::milliseconds(options.timeout_ms));
   const auto module_address = static_cast<uint8_t>(options.module_address);
   if (options.count) return tools::read_program(client.value(), options.start, *options.count, module_address);
@@ -58,7 +58,7 @@ int run_disasm(const DisasmOptions& options) {
     print_error("--start and --count apply to reading a module's memory (--tcp or --serial)");
     return kExitUsageError;
   }
-  const tools::Result<std::vector<tmcl::Instruction>> program =
+  const Result<std::vector<tmcl::Instruction>> program =
       options.binary.empty() ? read_from_module(options) : tools::read_program_binary(options.binary);
   if (!program) {
     print_error(program.error());

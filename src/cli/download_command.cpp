@@ -42,13 +42,13 @@ int run_download(const DownloadOptions& options) {
     print_error(fmt::format("{} holds no instruction", options.program));
     return kExitProgramError;
   }
-  tools::Result<tools::TmclClient> client = connect(options.connection);
+  Result<tools::TmclClient> client = connect(options.connection);
   if (!client) {
     print_error(client.error());
     return kExitUsageError;
   }
   const uint8_t address = options.connection.address();
-  const tools::Result<size_t> downloaded =
+  const Result<size_t> downloaded =
       tools::download_program(client.value(), program->instructions, options.start, address);
   if (!downloaded) {
     print_error(fmt::format("download to {} failed: {}", client->peer_name(), downloaded.error()));
@@ -62,7 +62,7 @@ int run_download(const DownloadOptions& options) {
     return kExitSuccess;
   }
 
-  const tools::Result<std::vector<tmcl::Instruction>> stored =
+  const Result<std::vector<tmcl::Instruction>> stored =
       tools::read_program(client.value(), options.start, static_cast<uint32_t>(count), address);
   if (!stored) {
     print_error(fmt::format("downloaded, but reading it back from {} failed: {}", client->peer_name(), stored.error()));

@@ -7,8 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "tools/result.h"
 #include "tools/tmcl_client.h"
+#include "types/result.h"
 
 namespace motwin::cli {
 
@@ -36,11 +36,11 @@ inline void add_connection_options(CLI::App& command, ModuleConnection& connecti
 }
 
 // Exactly one of --tcp and --serial must be given.
-inline tools::Result<tools::TmclClient> connect(const ModuleConnection& connection) {
+inline Result<tools::TmclClient> connect(const ModuleConnection& connection) {
   if (connection.tcp_address.empty() == connection.serial_device.empty()) {
-    return tools::Error{"give exactly one of --tcp HOST:PORT or --serial DEVICE"};
+    return Error{"give exactly one of --tcp HOST:PORT or --serial DEVICE"};
   }
-  tools::Result<tools::TmclClient> client =
+  Result<tools::TmclClient> client =
       connection.tcp_address.empty()
           ? tools::TmclClient::open_serial(connection.serial_device)
           : tools::TmclClient::connect_tcp(connection.tcp_address, std::chrono::milliseconds(connection.timeout_ms));

@@ -25,7 +25,7 @@ namespace cmd = tmcl::command;
 // Sends one control command; prints the error and returns std::nullopt unless status 100.
 std::optional<tools::TmclReply> control(tools::TmclClient& client, const ModuleConnection& connection,
                                         const tmcl::Instruction& request, const std::string& what) {
-  const tools::Result<tools::TmclReply> reply = client.request(request, connection.address());
+  const Result<tools::TmclReply> reply = client.request(request, connection.address());
   if (!reply) {
     print_error(fmt::format("{}: {}", what, reply.error()));
     return std::nullopt;
@@ -71,7 +71,7 @@ int run_start(const StartOptions& options) {
     }
     address = *found;
   }
-  tools::Result<tools::TmclClient> client = connect(options.connection);
+  Result<tools::TmclClient> client = connect(options.connection);
   if (!client) {
     print_error(client.error());
     return kExitUsageError;
@@ -94,7 +94,7 @@ int run_start(const StartOptions& options) {
 
 int run_simple(const ModuleConnection& connection, const tmcl::Instruction& request, const std::string& what,
                const std::string& done) {
-  tools::Result<tools::TmclClient> client = connect(connection);
+  Result<tools::TmclClient> client = connect(connection);
   if (!client) {
     print_error(client.error());
     return kExitUsageError;
@@ -117,7 +117,7 @@ std::string application_status_name(uint32_t mode) {
 }
 
 int run_status(const ModuleConnection& connection) {
-  tools::Result<tools::TmclClient> client = connect(connection);
+  Result<tools::TmclClient> client = connect(connection);
   if (!client) {
     print_error(client.error());
     return kExitUsageError;

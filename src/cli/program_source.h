@@ -43,7 +43,7 @@ inline std::optional<LoadedProgram> load_program(const std::string& path, const 
                                                  int& exit_status) {
   LoadedProgram program;
   if (is_binary_program(path)) {
-    tools::Result<std::vector<tmcl::Instruction>> binary = tools::read_program_binary(path);
+    Result<std::vector<tmcl::Instruction>> binary = tools::read_program_binary(path);
     if (!binary) {
       print_error(binary.error());
       exit_status = kExitUsageError;

@@ -174,11 +174,13 @@ int run_serve(const ServeArguments& arguments) {
   if (descriptor == nullptr) {
     throw ServeError{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
   }
-  std::string error;
-  const std::optional<host::Pacing> pacing = host::Pacing::parse(arguments.speed, error);
-  if (!pacing) throw ServeError{error};
+  const Result<host::Pacing> pacing = host::Pacing::parse(arguments.speed);
+  if (!pacing) throw ServeError{pacing.error()};
   // The crash-point test hook, before any image is opened: opening may already write one.
-  if (!host::install_persist_crash_hook_from_environment(error)) throw ServeError{error};
+  if (const Result<void> hook = host::install_persist_crash_hook_from_environment(); !hook) {
+    throw ServeError{hook.error()};
+  }
+  std::string error;
 
   host::ModuleOptions options;
   options.motor = arguments.motor;
@@ -195,14 +197,14 @@ int run_serve(const ServeArguments& arguments) {
   }
   std::vector<host::TcpEndpointSpec> tcp_specs;
   for (const std::string& text : arguments.tcp_endpoints) {
-    const std::optional<host::TcpEndpointSpec> spec = host::parse_tcp_endpoint(text, error);
-    if (!spec) throw ServeError{"--tmcl-tcp: " + error};
+    const Result<host::TcpEndpointSpec> spec = host::parse_tcp_endpoint(text);
+    if (!spec) throw ServeError{"--tmcl-tcp: " + spec.error()};
     tcp_specs.push_back(*spec);
   }
   std::vector<host::CanEndpointSpec> can_specs;
   for (const std::string& text : arguments.can_endpoints) {
-    const std::optional<host::CanEndpointSpec> spec = host::parse_can_endpoint(text, error);
-    if (!spec) throw ServeError{"--can: " + error};
+    const Result<host::CanEndpointSpec> spec = host::parse_can_endpoint(text);
+    if (!spec) throw ServeError{"--can: " + spec.error()};
     can_specs.push_back(*spec);
   }
   options.node_id = static_cast<uint8_t>(arguments.node_id);
@@ -271,16 +273,17 @@ int run_serve(const ServeArguments& arguments) {
   // Endpoints are destroyed before the runtime they are attached to.
   std::vector<std::unique_ptr<host::TmclTcpServer>> tcp_servers;
   for (const host::TcpEndpointSpec& spec : tcp_specs) {
-    host::TmclTcpServer::OpenResult opened = host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec);
-    if (!opened.server) throw ServeError{opened.error};
-    tcp_servers.push_back(std::move(opened.server));
+    Result<std::unique_ptr<host::TmclTcpServer>> opened =
+        host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec);
+    if (!opened) throw ServeError{opened.error()};
+    tcp_servers.push_back(std::move(*opened));
   }
   std::unique_ptr<host::TmclPtyEndpoint> pty;
   if (!arguments.pty_link.empty()) {
-    host::TmclPtyEndpoint::OpenResult opened =
+    Result<std::unique_ptr<host::TmclPtyEndpoint>> opened =
         host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), arguments.pty_link);
-    if (!opened.endpoint) throw ServeError{opened.error};
-    pty = std::move(opened.endpoint);
+    if (!opened) throw ServeError{opened.error()};
+    pty = std::move(*opened);
   }
   // The virtual CAN bus, stamped with simulated time; the modules leave it before they go away.
   host::CanBus can_bus([&module] { return module.sim_time_us(); });
@@ -314,9 +317,9 @@ int run_serve(const ServeArguments& arguments) {
   } capture_membership{can_bus};
   if (!arguments.can_capture.empty()) {
     if (can_specs.empty()) throw ServeError{"--can-capture needs a CAN bus (--can)"};
-    host::CanCapture::OpenResult opened = host::CanCapture::open(arguments.can_capture);
-    if (!opened.capture) throw ServeError{"--can-capture: " + opened.error};
-    can_capture = std::move(opened.capture);
+    Result<std::unique_ptr<host::CanCapture>> opened = host::CanCapture::open(arguments.can_capture);
+    if (!opened) throw ServeError{"--can-capture: " + opened.error()};
+    can_capture = std::move(*opened);
     capture_membership.id = can_bus.attach(*can_capture);
   }
   std::vector<std::unique_ptr<host::SocketcandServer>> can_servers;
@@ -326,31 +329,34 @@ int run_serve(const ServeArguments& arguments) {
   std::vector<std::string> can_endpoint_lines;
   for (const host::CanEndpointSpec& spec : can_specs) {
     if (spec.transport == host::CanTransport::kSlcanPty) {
-      host::SlcanPtyEndpoint::OpenResult opened = host::SlcanPtyEndpoint::open(runtime.loop(), can_bus, spec.device);
-      if (!opened.endpoint) throw ServeError{"--can slcan:" + spec.device + ": " + opened.error};
-      can_endpoint_lines.push_back("endpoint can-slcan-pty " + opened.endpoint->link_path() + " " +
-                                   opened.endpoint->device_path());
-      slcan_ptys.push_back(std::move(opened.endpoint));
+      Result<std::unique_ptr<host::SlcanPtyEndpoint>> opened =
+          host::SlcanPtyEndpoint::open(runtime.loop(), can_bus, spec.device);
+      if (!opened) throw ServeError{"--can slcan:" + spec.device + ": " + opened.error()};
+      can_endpoint_lines.push_back("endpoint can-slcan-pty " + (*opened)->link_path() + " " + (*opened)->device_path());
+      slcan_ptys.push_back(std::move(*opened));
       continue;
     }
     if (spec.transport == host::CanTransport::kSocketcan) {
-      host::SocketcanEndpoint::OpenResult opened = host::SocketcanEndpoint::open(runtime.loop(), can_bus, spec.device);
-      if (!opened.endpoint) throw ServeError{"--can: " + opened.error};
-      can_endpoint_lines.push_back("endpoint can-socketcan " + opened.endpoint->interface_name());
-      socketcan_endpoints.push_back(std::move(opened.endpoint));
+      Result<std::unique_ptr<host::SocketcanEndpoint>> opened =
+          host::SocketcanEndpoint::open(runtime.loop(), can_bus, spec.device);
+      if (!opened) throw ServeError{"--can: " + opened.error()};
+      can_endpoint_lines.push_back("endpoint can-socketcan " + (*opened)->interface_name());
+      socketcan_endpoints.push_back(std::move(*opened));
       continue;
     }
     if (spec.transport == host::CanTransport::kSlcanTcp) {
-      host::SlcanTcpServer::OpenResult opened = host::SlcanTcpServer::open(runtime.loop(), can_bus, spec.tcp);
-      if (!opened.server) throw ServeError{"--can: " + opened.error};
-      can_endpoint_lines.push_back("endpoint can-slcan-tcp " + opened.server->local_address());
-      slcan_servers.push_back(std::move(opened.server));
+      Result<std::unique_ptr<host::SlcanTcpServer>> opened =
+          host::SlcanTcpServer::open(runtime.loop(), can_bus, spec.tcp);
+      if (!opened) throw ServeError{"--can: " + opened.error()};
+      can_endpoint_lines.push_back("endpoint can-slcan-tcp " + (*opened)->local_address());
+      slcan_servers.push_back(std::move(*opened));
       continue;
     }
-    host::SocketcandServer::OpenResult opened = host::SocketcandServer::open(runtime.loop(), can_bus, spec.tcp);
-    if (!opened.server) throw ServeError{"--can: " + opened.error};
-    can_endpoint_lines.push_back("endpoint can-socketcand " + opened.server->local_address());
-    can_servers.push_back(std::move(opened.server));
+    Result<std::unique_ptr<host::SocketcandServer>> opened =
+        host::SocketcandServer::open(runtime.loop(), can_bus, spec.tcp);
+    if (!opened) throw ServeError{"--can: " + opened.error()};
+    can_endpoint_lines.push_back("endpoint can-socketcand " + (*opened)->local_address());
+    can_servers.push_back(std::move(*opened));
   }
 
   std::shared_ptr<std::function<void()>> stats_reporter;

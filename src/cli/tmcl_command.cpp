@@ -66,13 +66,13 @@ int run_tmcl(const TmclOptions& options) {
     print_error("no instruction given: expected for example 'GAP 52 0' (see motwin tmcl --help)");
     return kExitUsageError;
   }
-  const tools::Result<tmcl::Instruction> instruction = tools::parse_instruction(join_words(options.instruction_words));
+  const Result<tmcl::Instruction> instruction = tools::parse_instruction(join_words(options.instruction_words));
   if (!instruction) {
     print_error(instruction.error());
     return kExitUsageError;
   }
 
-  tools::Result<tools::TmclClient> client =
+  Result<tools::TmclClient> client =
       options.tcp_address.empty()
           ? tools::TmclClient::open_serial(options.serial_device)
           : tools::TmclClient::connect_tcp(options.tcp_address, std::chrono::milliseconds(options.timeout_ms));
@@ -81,7 +81,7 @@ int run_tmcl(const TmclOptions& options) {
     return kExitUsageError;
   }
   client->set_reply_timeout(std::chrono::milliseconds(options.timeout_ms));
-  const tools::Result<tools::TmclReply> reply =
+  const Result<tools::TmclReply> reply =
       client->request(instruction.value(), static_cast<uint8_t>(options.module_address));
   if (!reply) {
     print_error(reply.error());

@@ -12,14 +12,10 @@ void put_u32_le(uint8_t* p, uint32_t v) {
 
 }  // namespace
 
-CanCapture::OpenResult CanCapture::open(const std::string& path) {
-  OpenResult result;
+Result<std::unique_ptr<CanCapture>> CanCapture::open(const std::string& path) {
   const bool pcap = path.size() >= 5 && path.compare(path.size() - 5, 5, ".pcap") == 0;
   std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (file == nullptr) {
-    result.error = "cannot create " + path + ": " + std::strerror(errno);
-    return result;
-  }
+  if (file == nullptr) return Error{"cannot create " + path + ": " + std::strerror(errno)};
   if (pcap) {
     uint8_t header[24] = {};
     put_u32_le(header, 0xA1B2C3D4);  // microsecond timestamps, little-endian file
@@ -28,13 +24,12 @@ CanCapture::OpenResult CanCapture::open(const std::string& path) {
     put_u32_le(header + 16, 65535);  // snaplen
     put_u32_le(header + 20, 227);    // LINKTYPE_CAN_SOCKETCAN
     if (std::fwrite(header, 1, sizeof(header), file) != sizeof(header) || std::fflush(file) != 0) {
-      result.error = "cannot write " + path + ": " + std::strerror(errno);
+      Error error{"cannot write " + path + ": " + std::strerror(errno)};
       std::fclose(file);
-      return result;
+      return error;
     }
   }
-  result.capture.reset(new CanCapture(file, pcap ? Format::kPcap : Format::kCandump));
-  return result;
+  return std::unique_ptr<CanCapture>(new CanCapture(file, pcap ? Format::kPcap : Format::kCandump));
 }
 
 CanCapture::~CanCapture() { std::fclose(file_); }

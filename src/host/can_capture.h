@@ -12,6 +12,7 @@
 
 #include "host/can_bus.h"
 #include "types/can_frame.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -19,12 +20,8 @@ class CanCapture final : public CanBusEndpoint {
  public:
   enum class Format : uint8_t { kPcap, kCandump };
 
-  struct OpenResult {
-    std::unique_ptr<CanCapture> capture;
-    std::string error;
-  };
   // Creates (truncates) `path`; the format follows its extension.
-  static OpenResult open(const std::string& path);
+  static Result<std::unique_ptr<CanCapture>> open(const std::string& path);
   ~CanCapture();
   CanCapture(const CanCapture&) = delete;
   CanCapture& operator=(const CanCapture&) = delete;

@@ -22,13 +22,11 @@ constexpr size_t kMaxFramesPerRead = 64;
 
 // --- SLCAN on a pseudo-terminal -------------------------------------------------------------
 
-SlcanPtyEndpoint::OpenResult SlcanPtyEndpoint::open(EventLoop& loop, CanBus& bus, const std::string& link_path,
-                                                    LogSink log) {
-  OpenResult result;
-  const PtyDevice pty = open_pty_device(link_path, result.error);
-  if (pty.master_fd < 0) return result;
-  result.endpoint.reset(new SlcanPtyEndpoint(loop, bus, pty, link_path, std::move(log)));
-  return result;
+Result<std::unique_ptr<SlcanPtyEndpoint>> SlcanPtyEndpoint::open(EventLoop& loop, CanBus& bus,
+                                                                 const std::string& link_path, LogSink log) {
+  const Result<PtyDevice> pty = open_pty_device(link_path);
+  if (!pty) return Error{pty.error()};
+  return std::unique_ptr<SlcanPtyEndpoint>(new SlcanPtyEndpoint(loop, bus, *pty, link_path, std::move(log)));
 }
 
 SlcanPtyEndpoint::SlcanPtyEndpoint(EventLoop& loop, CanBus& bus, const PtyDevice& device, std::string link_path,
@@ -69,37 +67,33 @@ void SlcanPtyEndpoint::write(const std::string& text) {
 
 // --- SocketCAN ------------------------------------------------------------------------------
 
-SocketcanEndpoint::OpenResult SocketcanEndpoint::open(EventLoop& loop, CanBus& bus, const std::string& interface,
-                                                      LogSink log) {
-  OpenResult result;
+Result<std::unique_ptr<SocketcanEndpoint>> SocketcanEndpoint::open(EventLoop& loop, CanBus& bus,
+                                                                   const std::string& interface, LogSink log) {
   if (interface.empty() || interface.size() >= IFNAMSIZ) {
-    result.error = "socketcan: bad interface name \"" + interface + "\"";
-    return result;
+    return Error{"socketcan: bad interface name \"" + interface + "\""};
   }
   const int fd = ::socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW);
   if (fd < 0) {
-    result.error = "socketcan:" + interface + ": cannot open a CAN socket (" + std::strerror(errno) +
-                   "): this kernel or container has no SocketCAN; use --can socketcand:... or slcan:... instead";
-    return result;
+    return Error{"socketcan:" + interface + ": cannot open a CAN socket (" + std::strerror(errno) +
+                 "): this kernel or container has no SocketCAN; use --can socketcand:... or slcan:... instead"};
   }
   ifreq request{};
   std::memcpy(request.ifr_name, interface.c_str(), interface.size() + 1);
   if (::ioctl(fd, SIOCGIFINDEX, &request) != 0) {
-    result.error = "socketcan:" + interface + ": no such CAN interface (" + std::strerror(errno) +
-                   "; create one with: ip link add dev " + interface + " type vcan && ip link set up " + interface + ")";
+    Error error{"socketcan:" + interface + ": no such CAN interface (" + std::strerror(errno) +
+                "; create one with: ip link add dev " + interface + " type vcan && ip link set up " + interface + ")"};
     ::close(fd);
-    return result;
+    return error;
   }
   sockaddr_can address{};
   address.can_family = AF_CAN;
   address.can_ifindex = request.ifr_ifindex;
   if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    result.error = "socketcan:" + interface + ": cannot bind (" + std::strerror(errno) + ")";
+    Error error{"socketcan:" + interface + ": cannot bind (" + std::strerror(errno) + ")"};
     ::close(fd);
-    return result;
+    return error;
   }
-  result.endpoint.reset(new SocketcanEndpoint(loop, bus, fd, interface, std::move(log)));
-  return result;
+  return std::unique_ptr<SocketcanEndpoint>(new SocketcanEndpoint(loop, bus, fd, interface, std::move(log)));
 }
 
 SocketcanEndpoint::SocketcanEndpoint(EventLoop& loop, CanBus& bus, int fd, std::string interface, LogSink log)

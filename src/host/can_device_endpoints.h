@@ -20,6 +20,7 @@
 #include "host/pty_device.h"
 #include "host/slcan_protocol.h"
 #include "types/can_frame.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -29,11 +30,8 @@ class SlcanPtyEndpoint final : public CanBusEndpoint {
   // dongle's buffer overflows.
   static constexpr size_t kMaxPendingOutputBytes = 256 * 1024;
 
-  struct OpenResult {
-    std::unique_ptr<SlcanPtyEndpoint> endpoint;
-    std::string error;
-  };
-  static OpenResult open(EventLoop& loop, CanBus& bus, const std::string& link_path, LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<SlcanPtyEndpoint>> open(EventLoop& loop, CanBus& bus, const std::string& link_path,
+                                                        LogSink log = log_to_stderr);
   SlcanPtyEndpoint(const SlcanPtyEndpoint&) = delete;
   SlcanPtyEndpoint& operator=(const SlcanPtyEndpoint&) = delete;
   ~SlcanPtyEndpoint();
@@ -60,11 +58,8 @@ class SlcanPtyEndpoint final : public CanBusEndpoint {
 
 class SocketcanEndpoint final : public CanBusEndpoint {
  public:
-  struct OpenResult {
-    std::unique_ptr<SocketcanEndpoint> endpoint;
-    std::string error;
-  };
-  static OpenResult open(EventLoop& loop, CanBus& bus, const std::string& interface, LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<SocketcanEndpoint>> open(EventLoop& loop, CanBus& bus, const std::string& interface,
+                                                         LogSink log = log_to_stderr);
   SocketcanEndpoint(const SocketcanEndpoint&) = delete;
   SocketcanEndpoint& operator=(const SocketcanEndpoint&) = delete;
   ~SocketcanEndpoint();

@@ -9,11 +9,11 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <string_view>
 
 #include "host/tcp_server.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -27,6 +27,6 @@ struct CanEndpointSpec {
   std::string device;  // kSlcanPty: the link path; kSocketcan: the interface name
 };
 
-std::optional<CanEndpointSpec> parse_can_endpoint(std::string_view text, std::string& error);
+Result<CanEndpointSpec> parse_can_endpoint(std::string_view text);
 
 }  // namespace motwin::host

@@ -113,72 +113,71 @@ std::vector<uint8_t> EepromFile::encode(const EepromImageIdentity& identity, con
   return file;
 }
 
-std::string EepromFile::validate(const EepromImageIdentity& identity, const std::vector<uint8_t>& file) {
+Result<void> EepromFile::validate(const EepromImageIdentity& identity, const std::vector<uint8_t>& file) {
   if (file.size() < kHeaderSize) {
-    return "truncated: " + std::to_string(file.size()) + " bytes, shorter than the " + std::to_string(kHeaderSize) +
-           "-byte header";
+    return Error{"truncated: " + std::to_string(file.size()) + " bytes, shorter than the " +
+                 std::to_string(kHeaderSize) + "-byte header"};
   }
-  if (std::memcmp(file.data(), kMagic, sizeof(kMagic)) != 0) return "bad magic, not a Motwin EEPROM image";
-  if (get_u32(&file[kHeaderCrcOffset]) != crc32(file.data(), kHeaderCrcOffset)) return "header CRC mismatch";
+  if (std::memcmp(file.data(), kMagic, sizeof(kMagic)) != 0) return Error{"bad magic, not a Motwin EEPROM image"};
+  if (get_u32(&file[kHeaderCrcOffset]) != crc32(file.data(), kHeaderCrcOffset)) return Error{"header CRC mismatch"};
   const uint32_t format_version = get_u32(&file[kFormatVersionOffset]);
   if (format_version != kFormatVersion || get_u32(&file[kHeaderSizeOffset]) != kHeaderSize) {
-    return "unsupported file format version " + std::to_string(format_version);
+    return Error{"unsupported file format version " + std::to_string(format_version)};
   }
   const auto* name_field = reinterpret_cast<const char*>(&file[kModuleNameOffset]);
   const std::string stored_name(name_field, strnlen(name_field, kModuleNameField));
-  if (stored_name != identity.module_name) return "image of another module: " + stored_name;
+  if (stored_name != identity.module_name) return Error{"image of another module: " + stored_name};
   const uint32_t layout_version = get_u32(&file[kLayoutVersionOffset]);
   if (layout_version != identity.layout_version) {
-    return "NVM layout version " + std::to_string(layout_version) + ", expected " +
-           std::to_string(identity.layout_version);
+    return Error{"NVM layout version " + std::to_string(layout_version) + ", expected " +
+                 std::to_string(identity.layout_version)};
   }
   const uint32_t payload_size = get_u32(&file[kPayloadSizeOffset]);
   if (payload_size != identity.payload_size) {
-    return "payload size " + std::to_string(payload_size) + ", expected " + std::to_string(identity.payload_size);
+    return Error{"payload size " + std::to_string(payload_size) + ", expected " +
+                 std::to_string(identity.payload_size)};
   }
   const size_t present = file.size() - kHeaderSize;
   if (present < payload_size) {
-    return "truncated: " + std::to_string(present) + " of " + std::to_string(payload_size) + " payload bytes";
+    return Error{"truncated: " + std::to_string(present) + " of " + std::to_string(payload_size) + " payload bytes"};
   }
-  if (present > payload_size) return std::to_string(present - payload_size) + " unexpected bytes after the payload";
-  if (get_u32(&file[kPayloadCrcOffset]) != crc32(&file[kHeaderSize], payload_size)) return "payload CRC mismatch";
+  if (present > payload_size) {
+    return Error{std::to_string(present - payload_size) + " unexpected bytes after the payload"};
+  }
+  if (get_u32(&file[kPayloadCrcOffset]) != crc32(&file[kHeaderSize], payload_size)) {
+    return Error{"payload CRC mismatch"};
+  }
   return {};
 }
 
-EepromFile::OpenResult EepromFile::open(const std::filesystem::path& state_dir, const EepromImageIdentity& identity,
-                                        const FactoryImageFormatter& format_factory_image, const LogSink& log) {
-  OpenResult result;
+Result<std::unique_ptr<EepromFile>> EepromFile::open(const std::filesystem::path& state_dir,
+                                                     const EepromImageIdentity& identity,
+                                                     const FactoryImageFormatter& format_factory_image,
+                                                     const LogSink& log) {
   if (identity.module_name.empty() || identity.module_name.size() > kMaxModuleNameLength) {
-    result.error = "module name \"" + identity.module_name + "\" does not fit an EEPROM image header";
-    return result;
+    return Error{"module name \"" + identity.module_name + "\" does not fit an EEPROM image header"};
   }
   std::error_code ec;
   std::filesystem::create_directories(state_dir, ec);
-  if (ec) {
-    result.error = "cannot create state directory " + state_dir.string() + ": " + ec.message();
-    return result;
-  }
+  if (ec) return Error{"cannot create state directory " + state_dir.string() + ": " + ec.message()};
   const std::filesystem::path path = image_path(state_dir, identity.module_name);
   const int directory_fd = ::open(state_dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (directory_fd < 0) {
-    result.error = "cannot open state directory " + state_dir.string() + ": " + errno_text(errno);
-    return result;
-  }
+  if (directory_fd < 0) return Error{"cannot open state directory " + state_dir.string() + ": " + errno_text(errno)};
   // The lock file is never removed: removing it would race with a second server taking it.
   const std::string lock_path = path.string() + ".lock";
   const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (lock_fd < 0) {
-    result.error = "cannot create " + lock_path + ": " + errno_text(errno);
+    Error error{"cannot create " + lock_path + ": " + errno_text(errno)};
     ::close(directory_fd);
-    return result;
+    return error;
   }
   if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
-    result.error = errno == EWOULDBLOCK
-                       ? "EEPROM image " + path.string() + " is in use by another motwin process (use another --state-dir)"
-                       : "cannot lock " + lock_path + ": " + errno_text(errno);
+    Error error{errno == EWOULDBLOCK
+                    ? "EEPROM image " + path.string() + " is in use by another motwin process (use another --state-dir)"
+                    : "cannot lock " + lock_path + ": " + errno_text(errno)};
     ::close(lock_fd);
     ::close(directory_fd);
-    return result;
+    return error;
   }
   std::unique_ptr<EepromFile> file(new EepromFile(path, identity, directory_fd, lock_fd, log));
   // A temporary file is left only by a crash during a write; the image itself is complete.
@@ -189,26 +188,22 @@ EepromFile::OpenResult EepromFile::open(const std::filesystem::path& state_dir, 
   if (read_error == ENOENT) {
     file->load_outcome_ = EepromLoadOutcome::kCreated;
   } else if (read_error != 0) {
-    result.error = "cannot read EEPROM image " + path.string() + ": " + errno_text(read_error);
-    return result;
-  } else if (std::string problem = validate(identity, bytes); !problem.empty()) {
+    return Error{"cannot read EEPROM image " + path.string() + ": " + errno_text(read_error)};
+  } else if (const Result<void> valid = validate(identity, bytes); !valid) {
     file->load_outcome_ = EepromLoadOutcome::kReplacedDamaged;
-    log("motwin: EEPROM image " + path.string() + " is damaged (" + problem + "); using factory defaults");
+    log("motwin: EEPROM image " + path.string() + " is damaged (" + valid.error() + "); using factory defaults");
     // Keep the evidence; if even that fails the damaged file is simply overwritten below.
     const std::string damaged_path = path.string() + ".damaged";
     (void)::rename(path.c_str(), damaged_path.c_str());
   } else {
     std::memcpy(file->image_.data(), bytes.data() + kHeaderSize, identity.payload_size);
-    result.file = std::move(file);
-    return result;
+    return file;
   }
   format_factory_image(file->image_.data(), file->image_.size());
   if (const int error = file->persist(); error != 0) {
-    result.error = "cannot write EEPROM image " + path.string() + ": " + errno_text(error);
-    return result;
+    return Error{"cannot write EEPROM image " + path.string() + ": " + errno_text(error)};
   }
-  result.file = std::move(file);
-  return result;
+  return file;
 }
 
 EepromFile::EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd,

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "board/non_volatile_memory.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -59,17 +60,15 @@ class EepromFile final : public board::NonVolatileMemory {
   static constexpr size_t kHeaderSize = 64;
   static constexpr size_t kMaxModuleNameLength = 31;
 
-  struct OpenResult {
-    std::unique_ptr<EepromFile> file;
-    std::string error;  // set when file is null: the state directory is unusable
-  };
-
   // Creates `state_dir` if needed, takes an exclusive lock (`<path>.lock`, so that two servers
   // never write one image), removes a temporary file left by a crash, and loads the image.
   // A missing, damaged or foreign image is replaced by the factory image (written to disk);
-  // damaged or foreign also logs exactly one line through `log`.
-  static OpenResult open(const std::filesystem::path& state_dir, const EepromImageIdentity& identity,
-                         const FactoryImageFormatter& format_factory_image, const LogSink& log = log_to_stderr);
+  // damaged or foreign also logs exactly one line through `log`. Fails when the state
+  // directory is unusable or the image is in use by another process.
+  static Result<std::unique_ptr<EepromFile>> open(const std::filesystem::path& state_dir,
+                                                  const EepromImageIdentity& identity,
+                                                  const FactoryImageFormatter& format_factory_image,
+                                                  const LogSink& log = log_to_stderr);
 
   static std::filesystem::path image_path(const std::filesystem::path& state_dir, std::string_view module_name);
 
@@ -101,8 +100,8 @@ class EepromFile final : public board::NonVolatileMemory {
 
   // Encodes a complete file for `payload` (exposed for tests and tools).
   static std::vector<uint8_t> encode(const EepromImageIdentity& identity, const uint8_t* payload);
-  // Empty when `file_bytes` is a valid image for `identity`, otherwise why not ("bad magic" ...).
-  static std::string validate(const EepromImageIdentity& identity, const std::vector<uint8_t>& file_bytes);
+  // Success when `file_bytes` is a valid image for `identity`, otherwise why not ("bad magic" ...).
+  static Result<void> validate(const EepromImageIdentity& identity, const std::vector<uint8_t>& file_bytes);
 
  private:
   EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd, LogSink log);

@@ -12,6 +12,7 @@
 #include "board/ram_non_volatile_memory.h"
 #include "host/eeprom_file.h"
 #include "host/module_descriptor.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -38,23 +39,21 @@ class ModuleEeprom {
   using MemoryImage = board::RamNonVolatileMemory<kImageSize>;
 
   // Opens (or creates) the file when options.state_dir is set, otherwise formats a memory image.
-  // False, with `error` set, when the file cannot be used.
-  bool open(const ModuleOptions& options, const EepromImageIdentity& identity,
-            const FactoryImageFormatter& format_factory_image, std::string& error) {
+  // Fails when the file cannot be used.
+  Result<void> open(const ModuleOptions& options, const EepromImageIdentity& identity,
+                    const FactoryImageFormatter& format_factory_image) {
     if (options.state_dir) {
-      EepromFile::OpenResult opened = EepromFile::open(*options.state_dir, identity, format_factory_image, options.log);
-      if (!opened.file) {
-        error = opened.error;
-        return false;
-      }
-      file_ = std::move(opened.file);
+      Result<std::unique_ptr<EepromFile>> opened =
+          EepromFile::open(*options.state_dir, identity, format_factory_image, options.log);
+      if (!opened) return Error{opened.error()};
+      file_ = std::move(*opened);
       nvm_ = file_.get();
     } else {
       memory_image_ = std::make_unique<MemoryImage>();
       format_factory_image(memory_image_->mutable_data(), memory_image_->size());
       nvm_ = memory_image_.get();
     }
-    return true;
+    return {};
   }
 
   board::NonVolatileMemory& nvm() { return *nvm_; }

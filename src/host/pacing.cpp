@@ -8,15 +8,14 @@
 
 namespace motwin::host {
 
-std::optional<Pacing> Pacing::parse(std::string_view text, std::string& error) {
+Result<Pacing> Pacing::parse(std::string_view text) {
   if (text == "realtime") return realtime();
   if (text == "fast") return fast();
   const std::optional<double> factor = sim::parse_number(text);
   // Below 1e-3 a single 50 µs tick would take more than 50 ms of wall time; above 1e4 a paced
   // run is "fast" in all but name.
   if (!factor || *factor < 1e-3 || *factor > 1e4) {
-    error = "--speed takes realtime, fast or a factor from 0.001 to 10000, got \"" + std::string(text) + "\"";
-    return std::nullopt;
+    return Error{"--speed takes realtime, fast or a factor from 0.001 to 10000, got \"" + std::string(text) + "\""};
   }
   return Pacing::factor(*factor);
 }

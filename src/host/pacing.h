@@ -12,9 +12,10 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <string_view>
+
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -27,8 +28,8 @@ struct Pacing {
   static Pacing fast() { return Pacing{Mode::kFast, 1.0}; }
   static Pacing factor(double speed_factor) { return Pacing{Mode::kPaced, speed_factor}; }
 
-  // "realtime", "fast" or a positive factor ("2", "0.5"). On failure sets `error`.
-  static std::optional<Pacing> parse(std::string_view text, std::string& error);
+  // "realtime", "fast" or a positive factor ("2", "0.5").
+  static Result<Pacing> parse(std::string_view text);
   std::string describe() const;  // "realtime", "fast", "x2"
 };
 

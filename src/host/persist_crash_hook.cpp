@@ -3,6 +3,7 @@
 #include <array>
 #include <csignal>
 #include <cstdlib>
+#include <optional>
 
 namespace motwin::host {
 namespace {
@@ -54,7 +55,7 @@ std::string_view persist_step_name(PersistStep step) {
   return "?";
 }
 
-std::optional<PersistCrashPoint> parse_persist_crash_point(std::string_view text, std::string& error) {
+Result<PersistCrashPoint> parse_persist_crash_point(std::string_view text) {
   const size_t colon = text.find(':');
   const std::string_view step_text = text.substr(0, colon);
   std::optional<PersistStep> step;
@@ -64,23 +65,22 @@ std::optional<PersistCrashPoint> parse_persist_crash_point(std::string_view text
   std::optional<uint64_t> persist_number = uint64_t{1};
   if (colon != std::string_view::npos) persist_number = parse_persist_number(text.substr(colon + 1));
   if (!step || !persist_number) {
-    error = std::string(kCrashAtPersistStepVariable) + "=\"" + std::string(text) + "\": " + expected_form();
-    return std::nullopt;
+    return Error{std::string(kCrashAtPersistStepVariable) + "=\"" + std::string(text) + "\": " + expected_form()};
   }
   return PersistCrashPoint{*step, *persist_number};
 }
 
-bool install_persist_crash_hook_from_environment(std::string& error) {
+Result<void> install_persist_crash_hook_from_environment() {
   const char* value = std::getenv(kCrashAtPersistStepVariable);
-  if (value == nullptr || value[0] == '\0') return true;
-  const std::optional<PersistCrashPoint> point = parse_persist_crash_point(value, error);
-  if (!point) return false;
+  if (value == nullptr || value[0] == '\0') return {};
+  const Result<PersistCrashPoint> point = parse_persist_crash_point(value);
+  if (!point) return Error{point.error()};
   EepromFile::set_process_persist_observer([point = *point, writes_started = uint64_t{0}](PersistStep step) mutable {
     if (step == PersistStep::kOpenTemporary) ++writes_started;
     // SIGKILL, not abort() or exit(): no handler, no flush, no destructor runs, as in a real crash.
     if (step == point.step && writes_started == point.persist_number) std::raise(SIGKILL);
   });
-  return true;
+  return {};
 }
 
 }  // namespace motwin::host

@@ -7,11 +7,11 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <string_view>
 
 #include "host/eeprom_file.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -26,12 +26,12 @@ struct PersistCrashPoint {
 std::string_view persist_step_name(PersistStep step);
 
 // "write-temporary", "rename:3" ...; anything else (an unknown step, N of 0, a sign, spaces, a
-// number that does not fit) is nullopt with `error` saying what was expected.
-std::optional<PersistCrashPoint> parse_persist_crash_point(std::string_view text, std::string& error);
+// number that does not fit) fails with a message saying what was expected.
+Result<PersistCrashPoint> parse_persist_crash_point(std::string_view text);
 
 // Reads the variable (once, at start-up): unset or empty installs nothing; a valid value makes
-// the crash the process's persist observer (EepromFile::set_process_persist_observer). False,
-// with `error` set, for a bad value: a start-up error.
-bool install_persist_crash_hook_from_environment(std::string& error);
+// the crash the process's persist observer (EepromFile::set_process_persist_observer). A bad
+// value fails: a start-up error.
+Result<void> install_persist_crash_hook_from_environment();
 
 }  // namespace motwin::host

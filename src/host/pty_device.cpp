@@ -21,42 +21,41 @@ std::string read_link(const std::string& path) {
   return n < 0 ? std::string() : std::string(target, static_cast<size_t>(n));
 }
 
-// Empty on success, otherwise why `link_path` cannot be (re)placed.
-std::string place_link(const std::string& link_path, const std::string& device_path) {
+// Points `link_path` at `device_path`, or says why it cannot be (re)placed.
+Result<void> place_link(const std::string& link_path, const std::string& device_path) {
   struct stat existing {};
   if (::lstat(link_path.c_str(), &existing) == 0) {
-    if (!S_ISLNK(existing.st_mode)) return link_path + " exists and is not a symbolic link; not replacing it";
+    if (!S_ISLNK(existing.st_mode)) return Error{link_path + " exists and is not a symbolic link; not replacing it"};
     const std::string target = read_link(link_path);
     struct stat target_info {};
     const bool stale = ::stat(link_path.c_str(), &target_info) != 0;
     if (!stale && target.rfind("/dev/pts/", 0) != 0) {
-      return link_path + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it";
+      return Error{link_path + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it"};
     }
   } else if (errno != ENOENT) {
-    return "cannot inspect " + link_path + ": " + std::strerror(errno);
+    return Error{"cannot inspect " + link_path + ": " + std::strerror(errno)};
   }
   // Create beside it and rename over it, so the link is never missing or half made.
   const std::string temporary = link_path + ".motwin-" + std::to_string(::getpid());
   ::unlink(temporary.c_str());
   if (::symlink(device_path.c_str(), temporary.c_str()) != 0) {
-    return "cannot create symbolic link " + link_path + ": " + std::strerror(errno);
+    return Error{"cannot create symbolic link " + link_path + ": " + std::strerror(errno)};
   }
   if (::rename(temporary.c_str(), link_path.c_str()) != 0) {
     const int error = errno;
     ::unlink(temporary.c_str());
-    return "cannot create symbolic link " + link_path + ": " + std::strerror(error);
+    return Error{"cannot create symbolic link " + link_path + ": " + std::strerror(error)};
   }
   return {};
 }
 
 }  // namespace
 
-PtyDevice open_pty_device(const std::string& link_path, std::string& error) {
-  auto fail = [&](const std::string& what, int master_fd, int slave_fd) {
-    error = what;
+Result<PtyDevice> open_pty_device(const std::string& link_path) {
+  auto fail = [](const std::string& what, int master_fd, int slave_fd) {
     if (slave_fd >= 0) ::close(slave_fd);
     if (master_fd >= 0) ::close(master_fd);
-    return PtyDevice{};
+    return Error{what};
   };
   if (link_path.empty()) return fail("the pseudo-terminal link path is empty", -1, -1);
   const int master_fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
@@ -88,7 +87,7 @@ PtyDevice open_pty_device(const std::string& link_path, std::string& error) {
     return fail("cannot make the pseudo-terminal non-blocking: " + std::string(std::strerror(errno)), master_fd,
                 slave_fd);
   }
-  if (std::string problem = place_link(link_path, device); !problem.empty()) return fail(problem, master_fd, slave_fd);
+  if (Result<void> linked = place_link(link_path, device); !linked) return fail(linked.error(), master_fd, slave_fd);
   return PtyDevice{master_fd, slave_fd, device};
 }
 

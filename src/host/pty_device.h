@@ -13,6 +13,7 @@
 
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -23,9 +24,9 @@ struct PtyDevice {
 };
 
 // Creates the pty and the link. An existing symbolic link is replaced when it is stale or points
-// into /dev/pts (left by an earlier run); anything else at `link_path` is an error. On failure
-// returns master_fd -1 with `error` set and nothing left open.
-PtyDevice open_pty_device(const std::string& link_path, std::string& error);
+// into /dev/pts (left by an earlier run); anything else at `link_path` is an error. A failure
+// leaves nothing open.
+Result<PtyDevice> open_pty_device(const std::string& link_path);
 
 // Removes the link if it still points to `device_path` (another instance may own it now).
 void remove_pty_link(const std::string& link_path, const std::string& device_path);

@@ -2,13 +2,11 @@
 
 namespace motwin::host {
 
-TmclPtyEndpoint::OpenResult TmclPtyEndpoint::open(EventLoop& loop, TmclHostService& service,
-                                                  const std::string& link_path, LogSink log) {
-  OpenResult result;
-  const PtyDevice pty = open_pty_device(link_path, result.error);
-  if (pty.master_fd < 0) return result;
-  result.endpoint.reset(new TmclPtyEndpoint(loop, service, pty, link_path, std::move(log)));
-  return result;
+Result<std::unique_ptr<TmclPtyEndpoint>> TmclPtyEndpoint::open(EventLoop& loop, TmclHostService& service,
+                                                               const std::string& link_path, LogSink log) {
+  const Result<PtyDevice> pty = open_pty_device(link_path);
+  if (!pty) return Error{pty.error()};
+  return std::unique_ptr<TmclPtyEndpoint>(new TmclPtyEndpoint(loop, service, *pty, link_path, std::move(log)));
 }
 
 TmclPtyEndpoint::TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, const PtyDevice& device,

@@ -23,6 +23,7 @@
 #include "host/pty_device.h"
 #include "host/event_loop.h"
 #include "host/tmcl_host_service.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -32,14 +33,10 @@ class TmclPtyEndpoint final : public ReplyChannel {
   // line with no listener loses them too), and a client's input flush drops them all.
   static constexpr size_t kMaxPendingOutputBytes = 64 * 1024;
 
-  struct OpenResult {
-    std::unique_ptr<TmclPtyEndpoint> endpoint;
-    std::string error;
-  };
   // Creates the pty and the link. An existing symbolic link is replaced when it is stale or
   // points into /dev/pts (left by an earlier run); anything else at `link_path` is an error.
-  static OpenResult open(EventLoop& loop, TmclHostService& service, const std::string& link_path,
-                         LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<TmclPtyEndpoint>> open(EventLoop& loop, TmclHostService& service,
+                                                       const std::string& link_path, LogSink log = log_to_stderr);
 
   TmclPtyEndpoint(const TmclPtyEndpoint&) = delete;
   TmclPtyEndpoint& operator=(const TmclPtyEndpoint&) = delete;

@@ -46,20 +46,16 @@ class SlcanTcpServer::Session final : public TcpSession, public CanBusEndpoint {
   std::vector<can::CanFrame> outgoing_;
 };
 
-SlcanTcpServer::OpenResult SlcanTcpServer::open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
-                                                LogSink log) {
-  OpenResult result;
+Result<std::unique_ptr<SlcanTcpServer>> SlcanTcpServer::open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
+                                                             LogSink log) {
   TcpConnectionServer::Config config{"SLCAN", kMaxClients, kMaxPendingOutputBytes, "it does not read its frames"};
-  TcpConnectionServer::OpenResult opened = TcpConnectionServer::open(
+  Result<std::unique_ptr<TcpConnectionServer>> connections = TcpConnectionServer::open(
       loop, spec, std::move(config),
       [&bus](TcpConnection&) -> std::unique_ptr<TcpSession> { return std::make_unique<Session>(bus); }, std::move(log));
-  if (!opened.server) {
-    result.error = opened.error;
-    return result;
-  }
-  result.server.reset(new SlcanTcpServer());
-  result.server->connections_ = std::move(opened.server);
-  return result;
+  if (!connections) return Error{connections.error()};
+  std::unique_ptr<SlcanTcpServer> server(new SlcanTcpServer());
+  server->connections_ = std::move(*connections);
+  return server;
 }
 
 SlcanTcpServer::~SlcanTcpServer() = default;

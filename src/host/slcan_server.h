@@ -13,6 +13,7 @@
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
 #include "host/tcp_server.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -23,11 +24,8 @@ class SlcanTcpServer {
   static constexpr size_t kMaxClients = 64;
   static constexpr size_t kMaxPendingOutputBytes = 1024 * 1024;
 
-  struct OpenResult {
-    std::unique_ptr<SlcanTcpServer> server;
-    std::string error;
-  };
-  static OpenResult open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec, LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<SlcanTcpServer>> open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
+                                                      LogSink log = log_to_stderr);
 
   SlcanTcpServer(const SlcanTcpServer&) = delete;
   SlcanTcpServer& operator=(const SlcanTcpServer&) = delete;

@@ -67,35 +67,20 @@ std::vector<std::string_view> socketcand_words(std::string_view element) {
   return words;
 }
 
-std::optional<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words, std::string& error) {
-  if (words.size() < 3 || words[0] != "send") {
-    error = "send needs an ID and a length";
-    return std::nullopt;
-  }
+Result<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words) {
+  if (words.size() < 3 || words[0] != "send") return Error{"send needs an ID and a length"};
   can::CanFrame frame;
   uint32_t id = 0;
-  if (!parse_hex(words[1], id) || id > can::kMaxExtendedId) {
-    error = "bad CAN ID";
-    return std::nullopt;
-  }
+  if (!parse_hex(words[1], id) || id > can::kMaxExtendedId) return Error{"bad CAN ID"};
   frame.id = id;
   frame.extended = words[1].size() == 8 || id > can::kMaxStandardId;
   uint32_t length = 0;
-  if (!parse_hex(words[2], length) || length > can::kMaxDataLength) {
-    error = "bad length";
-    return std::nullopt;
-  }
-  if (words.size() != 3 + length) {
-    error = "length does not match the data";
-    return std::nullopt;
-  }
+  if (!parse_hex(words[2], length) || length > can::kMaxDataLength) return Error{"bad length"};
+  if (words.size() != 3 + length) return Error{"length does not match the data"};
   frame.dlc = static_cast<uint8_t>(length);
   for (uint32_t i = 0; i < length; ++i) {
     uint32_t byte = 0;
-    if (words[3 + i].size() > 2 || !parse_hex(words[3 + i], byte)) {
-      error = "bad data byte";
-      return std::nullopt;
-    }
+    if (words[3 + i].size() > 2 || !parse_hex(words[3 + i], byte)) return Error{"bad data byte"};
     frame.data[i] = static_cast<uint8_t>(byte);
   }
   return frame;

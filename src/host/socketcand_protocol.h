@@ -5,12 +5,12 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "types/can_frame.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -37,8 +37,8 @@ std::vector<std::string_view> socketcand_words(std::string_view element);
 
 // `send ID LEN [B]*` words (with "send" first) into a frame. ID in hex; extended when written with
 // 8 digits or above 0x7FF. LEN 0..8; exactly LEN data words of 1 or 2 hex digits, any case.
-// nullopt with `error` set otherwise.
-std::optional<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words, std::string& error);
+// Anything else fails with the text of socketcand's `< error TEXT >`.
+Result<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>& words);
 
 // ` < frame ID SEC.USEC HEXDATA >` with ID as %03X or %08X and the data as one uppercase hex
 // string; an empty frame has two spaces before `>`. The space between two frames is deliberate:

@@ -59,25 +59,20 @@ class SocketcandServer::Session final : public TcpSession, public CanBusEndpoint
   SocketcandSession session_{*this};
 };
 
-SocketcandServer::OpenResult SocketcandServer::open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
-                                                    LogSink log) {
-  OpenResult result;
+Result<std::unique_ptr<SocketcandServer>> SocketcandServer::open(EventLoop& loop, CanBus& bus,
+                                                                 const TcpEndpointSpec& spec, LogSink log) {
   std::unique_ptr<SocketcandServer> server(new SocketcandServer());
   SocketcandServer* raw = server.get();
   TcpConnectionServer::Config config{"socketcand", kMaxClients, kMaxPendingOutputBytes, "it does not read its frames"};
-  TcpConnectionServer::OpenResult opened = TcpConnectionServer::open(
+  Result<std::unique_ptr<TcpConnectionServer>> connections = TcpConnectionServer::open(
       loop, spec, std::move(config),
       [&bus, raw](TcpConnection&) -> std::unique_ptr<TcpSession> {
         return std::make_unique<Session>(bus, raw->connections_->lifetime(), *raw->connections_);
       },
       std::move(log));
-  if (!opened.server) {
-    result.error = opened.error;
-    return result;
-  }
-  server->connections_ = std::move(opened.server);
-  result.server = std::move(server);
-  return result;
+  if (!connections) return Error{connections.error()};
+  server->connections_ = std::move(*connections);
+  return server;
 }
 
 SocketcandServer::~SocketcandServer() = default;

@@ -27,6 +27,7 @@
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
 #include "host/tcp_server.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -39,11 +40,8 @@ class SocketcandServer {
   static constexpr size_t kMaxPendingOutputBytes = 1024 * 1024;
   static constexpr uint64_t kRawModeSettleUs = 50'000;
 
-  struct OpenResult {
-    std::unique_ptr<SocketcandServer> server;
-    std::string error;
-  };
-  static OpenResult open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec, LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<SocketcandServer>> open(EventLoop& loop, CanBus& bus, const TcpEndpointSpec& spec,
+                                                        LogSink log = log_to_stderr);
 
   SocketcandServer(const SocketcandServer&) = delete;
   SocketcandServer& operator=(const SocketcandServer&) = delete;

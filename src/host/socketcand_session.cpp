@@ -35,10 +35,9 @@ void SocketcandSession::handle(const std::string& element) {
     case Mode::kBcm:
     case Mode::kRaw:
       if (command == "send") {
-        std::string problem;
-        const std::optional<can::CanFrame> frame = parse_socketcand_send(words, problem);
+        const Result<can::CanFrame> frame = parse_socketcand_send(words);
         if (!frame) {
-          error(problem);
+          error(frame.error());
           return;
         }
         io_.send_to_bus(*frame);

@@ -119,13 +119,13 @@ void TcpConnection::close(const std::string& reason) {
   server_.remove(*this, reason);
 }
 
-TcpConnectionServer::OpenResult TcpConnectionServer::open(EventLoop& loop, const TcpEndpointSpec& spec, Config config,
-                                                          SessionFactory factory, LogSink log) {
-  OpenResult result;
-  const int fd = listen_tcp(spec, result.error);
-  if (fd < 0) return result;
-  result.server.reset(new TcpConnectionServer(loop, fd, std::move(config), std::move(factory), std::move(log)));
-  return result;
+Result<std::unique_ptr<TcpConnectionServer>> TcpConnectionServer::open(EventLoop& loop, const TcpEndpointSpec& spec,
+                                                                       Config config, SessionFactory factory,
+                                                                       LogSink log) {
+  const Result<int> fd = listen_tcp(spec);
+  if (!fd) return Error{fd.error()};
+  return std::unique_ptr<TcpConnectionServer>(
+      new TcpConnectionServer(loop, *fd, std::move(config), std::move(factory), std::move(log)));
 }
 
 TcpConnectionServer::TcpConnectionServer(EventLoop& loop, int listen_fd, Config config, SessionFactory factory,

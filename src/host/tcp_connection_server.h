@@ -16,6 +16,7 @@
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
 #include "host/tcp_server.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -101,12 +102,9 @@ class TcpConnectionServer {
   };
   using SessionFactory = std::function<std::unique_ptr<TcpSession>(TcpConnection& connection)>;
 
-  struct OpenResult {
-    std::unique_ptr<TcpConnectionServer> server;
-    std::string error;  // "cannot listen on 127.0.0.1:5000: Address already in use"
-  };
-  static OpenResult open(EventLoop& loop, const TcpEndpointSpec& spec, Config config, SessionFactory factory,
-                         LogSink log = log_to_stderr);
+  // Fails with "cannot listen on 127.0.0.1:5000: Address already in use" and the like.
+  static Result<std::unique_ptr<TcpConnectionServer>> open(EventLoop& loop, const TcpEndpointSpec& spec, Config config,
+                                                           SessionFactory factory, LogSink log = log_to_stderr);
 
   TcpConnectionServer(const TcpConnectionServer&) = delete;
   TcpConnectionServer& operator=(const TcpConnectionServer&) = delete;

@@ -29,14 +29,13 @@ std::optional<uint16_t> parse_port(std::string_view text) {
 
 }  // namespace
 
-std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::string& error) {
+Result<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text) {
   TcpEndpointSpec spec;
   std::string_view port_text = text;
   if (!text.empty() && text.front() == '[') {
     const size_t close = text.find("]:");
     if (close == std::string_view::npos) {
-      error = "expected [IPV6]:PORT, got \"" + std::string(text) + "\"";
-      return std::nullopt;
+      return Error{"expected [IPV6]:PORT, got \"" + std::string(text) + "\""};
     }
     spec.host = std::string(text.substr(1, close - 1));
     port_text = text.substr(close + 2);
@@ -46,14 +45,13 @@ std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::st
   }
   const std::optional<uint16_t> port = parse_port(port_text);
   if (spec.host.empty() || !port) {
-    error = "expected HOST:PORT with a port from 0 to 65535, got \"" + std::string(text) + "\"";
-    return std::nullopt;
+    return Error{"expected HOST:PORT with a port from 0 to 65535, got \"" + std::string(text) + "\""};
   }
   spec.port = *port;
   return spec;
 }
 
-int listen_tcp(const TcpEndpointSpec& spec, std::string& error) {
+Result<int> listen_tcp(const TcpEndpointSpec& spec) {
   const std::string where = (spec.host.find(':') != std::string::npos ? "[" + spec.host + "]" : spec.host) + ":" +
                             std::to_string(spec.port);
   addrinfo hints{};
@@ -63,8 +61,7 @@ int listen_tcp(const TcpEndpointSpec& spec, std::string& error) {
   addrinfo* addresses = nullptr;
   const std::string port_text = std::to_string(spec.port);
   if (const int status = ::getaddrinfo(spec.host.c_str(), port_text.c_str(), &hints, &addresses); status != 0) {
-    error = "cannot listen on " + where + ": " + ::gai_strerror(status);
-    return -1;
+    return Error{"cannot listen on " + where + ": " + ::gai_strerror(status)};
   }
   int listen_fd = -1;
   int last_errno = 0;
@@ -84,7 +81,7 @@ int listen_tcp(const TcpEndpointSpec& spec, std::string& error) {
     listen_fd = fd;
   }
   ::freeaddrinfo(addresses);
-  if (listen_fd < 0) error = "cannot listen on " + where + ": " + std::strerror(last_errno);
+  if (listen_fd < 0) return Error{"cannot listen on " + where + ": " + std::strerror(last_errno)};
   return listen_fd;
 }
 
@@ -152,21 +149,17 @@ class TmclTcpServer::Session final : public TcpSession, public ReplyChannel {
   bool input_closed_ = false;
 };
 
-TmclTcpServer::OpenResult TmclTcpServer::open(EventLoop& loop, TmclHostService& service, const TcpEndpointSpec& spec,
-                                              LogSink log) {
-  OpenResult result;
+Result<std::unique_ptr<TmclTcpServer>> TmclTcpServer::open(EventLoop& loop, TmclHostService& service,
+                                                           const TcpEndpointSpec& spec, LogSink log) {
   TcpConnectionServer::Config config{"TCP", kMaxClients, kMaxPendingOutputBytes, "it does not read its replies"};
-  TcpConnectionServer::OpenResult opened = TcpConnectionServer::open(
+  Result<std::unique_ptr<TcpConnectionServer>> connections = TcpConnectionServer::open(
       loop, spec, std::move(config),
       [&service](TcpConnection&) -> std::unique_ptr<TcpSession> { return std::make_unique<Session>(service); },
       std::move(log));
-  if (!opened.server) {
-    result.error = opened.error;
-    return result;
-  }
-  result.server.reset(new TmclTcpServer());
-  result.server->connections_ = std::move(opened.server);
-  return result;
+  if (!connections) return Error{connections.error()};
+  std::unique_ptr<TmclTcpServer> server(new TmclTcpServer());
+  server->connections_ = std::move(*connections);
+  return server;
 }
 
 TmclTcpServer::~TmclTcpServer() = default;

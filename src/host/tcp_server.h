@@ -7,7 +7,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
 
@@ -16,6 +15,7 @@
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
 #include "host/tmcl_host_service.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -27,8 +27,8 @@ struct TcpEndpointSpec {
   uint16_t port = kDefaultTcpPort;  // 0: the system picks a free port
 };
 
-// "HOST:PORT", ":PORT", "PORT" (host 127.0.0.1) or "[IPv6]:PORT". On failure sets `error`.
-std::optional<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text, std::string& error);
+// "HOST:PORT", ":PORT", "PORT" (host 127.0.0.1) or "[IPv6]:PORT".
+Result<TcpEndpointSpec> parse_tcp_endpoint(std::string_view text);
 
 class TcpConnectionServer;
 
@@ -42,12 +42,9 @@ class TmclTcpServer {
   // A client that lets this much reply data pile up is not reading: it is disconnected.
   static constexpr size_t kMaxPendingOutputBytes = 64 * 1024;
 
-  struct OpenResult {
-    std::unique_ptr<TmclTcpServer> server;
-    std::string error;  // "cannot listen on 127.0.0.1:5000: Address already in use"
-  };
-  static OpenResult open(EventLoop& loop, TmclHostService& service, const TcpEndpointSpec& spec,
-                         LogSink log = log_to_stderr);
+  // Fails with "cannot listen on 127.0.0.1:5000: Address already in use" and the like.
+  static Result<std::unique_ptr<TmclTcpServer>> open(EventLoop& loop, TmclHostService& service,
+                                                     const TcpEndpointSpec& spec, LogSink log = log_to_stderr);
 
   TmclTcpServer(const TmclTcpServer&) = delete;
   TmclTcpServer& operator=(const TmclTcpServer&) = delete;
@@ -65,9 +62,9 @@ class TmclTcpServer {
   std::unique_ptr<TcpConnectionServer> connections_;
 };
 
-// A non-blocking listening TCP socket (SO_REUSEADDR, backlog 16), or -1 with `error` set to
+// The descriptor of a non-blocking listening TCP socket (SO_REUSEADDR, backlog 16), or
 // "cannot listen on HOST:PORT: reason".
-int listen_tcp(const TcpEndpointSpec& spec, std::string& error);
+Result<int> listen_tcp(const TcpEndpointSpec& spec);
 
 // "127.0.0.1:5000" or "[::1]:5000" for an IPv4 or IPv6 socket address.
 std::string format_socket_address(const sockaddr_storage& address);

@@ -70,7 +70,8 @@ class TmclSimModule final : public VirtualModule {
                                             const FormatImage& format_image, const BuildDevice& build_device) {
     MakeModuleResult result;
     std::unique_ptr<TmclSimModule> module(new TmclSimModule());
-    if (!module->eeprom_.open(options, eeprom_identity(), format_image, result.error)) return result;
+    const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), format_image);
+    if (!eeprom) return refused(eeprom.error());
     module->board_ = motor ? std::make_unique<SimBoard>(module->io_, *motor) : std::make_unique<SimBoard>(module->io_);
     for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
     build_device(*module);

@@ -1,6 +1,7 @@
 #include "tools/canopen_client.h"
 
 #include <cerrno>
+#include <charconv>
 #include <chrono>
 #include <cstring>
 
@@ -21,17 +22,25 @@ int64_t now_ms() {
       .count();
 }
 
+// Digits only, at most `max_digits` of them (so the value fits); nullopt otherwise.
+std::optional<uint64_t> parse_digits(std::string_view digits, size_t max_digits) {
+  uint64_t value = 0;
+  const char* end = digits.data() + digits.size();
+  if (digits.empty() || digits.size() > max_digits) return std::nullopt;
+  const auto [stop, status] = std::from_chars(digits.data(), end, value);
+  if (status != std::errc{} || stop != end) return std::nullopt;
+  return value;
+}
+
 // "SEC.USEC" of a socketcand frame element into µs; 0 when malformed.
 uint64_t parse_timestamp_us(std::string_view text) {
   const size_t dot = text.find('.');
-  const std::string seconds(text.substr(0, dot));
   std::string fraction = dot == std::string_view::npos ? std::string() : std::string(text.substr(dot + 1));
   fraction.resize(6, '0');
-  if (seconds.empty() || seconds.find_first_not_of("0123456789") != std::string::npos ||
-      fraction.find_first_not_of("0123456789") != std::string::npos || seconds.size() > 12) {
-    return 0;
-  }
-  return std::stoull(seconds) * 1'000'000u + std::stoull(fraction);
+  const std::optional<uint64_t> seconds = parse_digits(text.substr(0, dot), 12);
+  const std::optional<uint64_t> microseconds = parse_digits(fraction, 6);
+  if (!seconds || !microseconds) return 0;
+  return *seconds * 1'000'000u + *microseconds;
 }
 
 std::optional<ReceivedFrame> parse_frame_element(const std::string& element) {
@@ -53,16 +62,14 @@ std::optional<ReceivedFrame> parse_frame_element(const std::string& element) {
 
 }  // namespace
 
-SocketcandClient::OpenResult SocketcandClient::connect(const std::string& host, uint16_t port, int timeout_ms,
-                                                       const std::string& channel) {
-  OpenResult result;
+Result<std::unique_ptr<SocketcandClient>> SocketcandClient::connect(const std::string& host, uint16_t port,
+                                                                    int timeout_ms, const std::string& channel) {
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* addresses = nullptr;
   if (const int status = ::getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &addresses); status != 0) {
-    result.error = "cannot resolve " + host + ": " + ::gai_strerror(status);
-    return result;
+    return Error{"cannot resolve " + host + ": " + ::gai_strerror(status)};
   }
   int fd = -1;
   int last_errno = 0;
@@ -79,27 +86,24 @@ SocketcandClient::OpenResult SocketcandClient::connect(const std::string& host, 
     }
   }
   ::freeaddrinfo(addresses);
-  if (fd < 0) {
-    result.error = "cannot connect to " + host + ":" + std::to_string(port) + ": " + std::strerror(last_errno);
-    return result;
-  }
+  if (fd < 0) return Error{"cannot connect to " + host + ":" + std::to_string(port) + ": " + std::strerror(last_errno)};
   const int on = 1;
   ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
   std::unique_ptr<SocketcandClient> client(new SocketcandClient(fd));
-  auto expect = [&](const char* what) {
+  const auto greeted = [&](const char* what) {
     const std::optional<std::string> element = client->element(timeout_ms);
     const std::vector<std::string_view> words = element ? host::socketcand_words(*element) : std::vector<std::string_view>{};
-    if (words.size() == 1 && words[0] == what) return true;
-    result.error = std::string("no < ") + what + " > from the socketcand server";
-    return false;
+    return words.size() == 1 && words[0] == what;
   };
-  if (!expect("hi")) return result;
+  const auto no_answer = [](const char* what) {
+    return Error{std::string("no < ") + what + " > from the socketcand server"};
+  };
+  if (!greeted("hi")) return no_answer("hi");
   const std::string open = "< open " + channel + " >";
-  if (::send(fd, open.data(), open.size(), MSG_NOSIGNAL) < 0 || !expect("ok")) return result;
+  if (::send(fd, open.data(), open.size(), MSG_NOSIGNAL) < 0 || !greeted("ok")) return no_answer("ok");
   const std::string raw = "< rawmode >";
-  if (::send(fd, raw.data(), raw.size(), MSG_NOSIGNAL) < 0 || !expect("ok")) return result;
-  result.client = std::move(client);
-  return result;
+  if (::send(fd, raw.data(), raw.size(), MSG_NOSIGNAL) < 0 || !greeted("ok")) return no_answer("ok");
+  return client;
 }
 
 SocketcandClient::~SocketcandClient() { ::close(fd_); }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "types/can_frame.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 
@@ -20,13 +21,9 @@ struct ReceivedFrame {
 
 class SocketcandClient {
  public:
-  struct OpenResult {
-    std::unique_ptr<SocketcandClient> client;
-    std::string error;
-  };
   // Connects, waits for `< hi >`, opens `channel` and enters raw mode.
-  static OpenResult connect(const std::string& host, uint16_t port, int timeout_ms = 2000,
-                            const std::string& channel = "can0");
+  static Result<std::unique_ptr<SocketcandClient>> connect(const std::string& host, uint16_t port,
+                                                           int timeout_ms = 2000, const std::string& channel = "can0");
   ~SocketcandClient();
   SocketcandClient(const SocketcandClient&) = delete;
   SocketcandClient& operator=(const SocketcandClient&) = delete;
@@ -48,6 +45,8 @@ class SocketcandClient {
   bool closed_ = false;
 };
 
+// Not a Result: a server's abort code is an answer the caller reports as such (its own exit
+// status), not a failure of the transfer.
 struct SdoResult {
   bool ok = false;
   uint32_t abort_code = 0;     // set when the server aborted

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "tools/fd_io.h"
-#include "tools/result.h"
 #include "tools/unique_fd.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

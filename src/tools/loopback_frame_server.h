@@ -12,8 +12,8 @@
 #include <thread>
 
 #include "core/tmcl/serial_link.h"
-#include "tools/result.h"
 #include "tools/unique_fd.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

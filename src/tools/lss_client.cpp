@@ -138,7 +138,7 @@ LssResult LssMaster::inquire(uint8_t command) {
   return result;
 }
 
-std::optional<LssIdentityNumbers> LssMaster::fastscan(int step_timeout_ms, std::string& error) {
+Result<LssIdentityNumbers> LssMaster::fastscan(int step_timeout_ms) {
   const auto probe = [this, step_timeout_ms](uint32_t id_number, uint8_t bit_checked, uint8_t sub, uint8_t next,
                                              int timeout_ms) {
     std::array<uint8_t, 8> data{kFastscan};
@@ -151,10 +151,7 @@ std::optional<LssIdentityNumbers> LssMaster::fastscan(int step_timeout_ms, std::
   };
   // Reset: every unconfigured slave in waiting state answers. The first probe may wait behind a
   // fresh connection's start-up, so it gets the long timeout.
-  if (!probe(0, kFastscanReset, 0, 0, timeout_ms_)) {
-    error = "no unconfigured LSS slave answered the fastscan";
-    return std::nullopt;
-  }
+  if (!probe(0, kFastscanReset, 0, 0, timeout_ms_)) return Error{"no unconfigured LSS slave answered the fastscan"};
   uint32_t parts[4] = {};
   for (uint8_t sub = 0; sub < 4; ++sub) {
     uint32_t id_number = 0;
@@ -166,8 +163,7 @@ std::optional<LssIdentityNumbers> LssMaster::fastscan(int step_timeout_ms, std::
     // number LSSNext 0 < LSSSub puts it into configuration state).
     const uint8_t next = static_cast<uint8_t>((sub + 1) % 4);
     if (!probe(id_number, 0, sub, next, timeout_ms_)) {
-      error = "fastscan lost the slave at part " + std::to_string(sub) + " (two slaves with one identity?)";
-      return std::nullopt;
+      return Error{"fastscan lost the slave at part " + std::to_string(sub) + " (two slaves with one identity?)"};
     }
     parts[sub] = id_number;
   }

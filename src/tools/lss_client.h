@@ -10,6 +10,7 @@
 #include <string>
 
 #include "tools/canopen_client.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 
@@ -23,7 +24,8 @@ struct LssIdentityNumbers {
   uint32_t serial_number = 0;
 };
 
-// The outcome of one LSS service: `ok`, or `error` (no answer, or the slave's error code).
+// The outcome of one LSS service: `ok`, or `error` (no answer, or the slave's error code). Not
+// a Result: the slave's error code and an inquired value are answers the caller uses.
 struct LssResult {
   bool ok = false;
   uint8_t error_code = 0;       // the slave answered with this error (configure/store)
@@ -49,8 +51,8 @@ class LssMaster {
 
   // Fastscan (CiA-305 8.4.2): finds the identity of one unconfigured slave in waiting state and
   // leaves that slave in configuration state. `step_timeout_ms` bounds the wait for an answer
-  // to each probe (no answer is part of the algorithm). nullopt when no slave answered.
-  std::optional<LssIdentityNumbers> fastscan(int step_timeout_ms, std::string& error);
+  // to each probe (no answer is part of the algorithm). Fails when no slave answered.
+  Result<LssIdentityNumbers> fastscan(int step_timeout_ms);
 
   // CiA-305 table 0 bit rates (kbit/s) to index; nullopt for others.
   static std::optional<uint8_t> bit_timing_index(uint32_t bit_rate_kbit);

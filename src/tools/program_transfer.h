@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "core/tmcl/instruction.h"
-#include "tools/result.h"
 #include "tools/tmcl_client.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

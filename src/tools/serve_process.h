@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "tools/child_process.h"
-#include "tools/result.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/tmcl/instruction.h"
-#include "tools/result.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

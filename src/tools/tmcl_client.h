@@ -11,8 +11,8 @@
 
 #include "core/tmcl/instruction.h"
 #include "core/tmcl/serial_link.h"
-#include "tools/result.h"
 #include "tools/unique_fd.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "core/tmcl/instruction.h"
-#include "tools/result.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

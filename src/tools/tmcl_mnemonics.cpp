@@ -125,38 +125,38 @@ std::variant<int64_t, Failure> operand_value(std::string_view word, std::span<co
 }
 
 // Range check and store into the instruction field.
-std::optional<std::string> store_field(Instruction& instruction, Field field, int64_t value, std::string_view what) {
+Result<void> store_field(Instruction& instruction, Field field, int64_t value, std::string_view what) {
   if (field == Field::kValue) {
     if (value < kValueMin || value > kValueMax) {
-      return fmt::format("{}: {} is out of range for the 32-bit value field ({}..{})", what, value, kValueMin,
-                         kValueMax);
+      return Error{fmt::format("{}: {} is out of range for the 32-bit value field ({}..{})", what, value, kValueMin,
+                               kValueMax)};
     }
     instruction.value = static_cast<int32_t>(static_cast<uint32_t>(value));
-    return std::nullopt;
+    return {};
   }
   if (value < 0 || value > kByteMax) {
-    return fmt::format("{}: {} is out of range for the byte field {} (0..{})", what, value, field_description(field),
-                       kByteMax);
+    return Error{fmt::format("{}: {} is out of range for the byte field {} (0..{})", what, value,
+                             field_description(field), kByteMax)};
   }
   if (field == Field::kType) {
     instruction.type = static_cast<uint8_t>(value);
   } else {
     instruction.motor_bank = static_cast<uint8_t>(value);
   }
-  return std::nullopt;
+  return {};
 }
 
 // Evaluates `word` (a view into `text`) and stores it; failures point at the word.
 std::optional<Failure> evaluate_and_store(std::string_view text, std::string_view word, std::span<const Symbol> symbols,
                                           const ParseOptions& options, std::string_view what,
-                                          const std::function<std::optional<std::string>(int64_t)>& store) {
+                                          const std::function<Result<void>(int64_t)>& store) {
   std::variant<int64_t, Failure> value = operand_value(word, symbols, options, what);
   if (Failure* failure = std::get_if<Failure>(&value)) {
     failure->offset += offset_in(text, word);
     return std::move(*failure);
   }
-  if (std::optional<std::string> message = store(std::get<int64_t>(value))) {
-    return Failure{std::move(*message), ParseErrorKind::kOutOfRange, offset_in(text, word), word.size()};
+  if (const Result<void> stored = store(*std::get_if<int64_t>(&value)); !stored) {
+    return Failure{stored.error(), ParseErrorKind::kOutOfRange, offset_in(text, word), word.size()};
   }
   return std::nullopt;
 }
@@ -175,12 +175,12 @@ std::variant<Instruction, Failure> parse_numeric_form(std::string_view text, std
   for (size_t i = 0; i < words.size(); ++i) {
     std::optional<Failure> failure;
     if (i == 0) {
-      const auto store_command = [&](int64_t value) -> std::optional<std::string> {
+      const auto store_command = [&](int64_t value) -> Result<void> {
         if (value < 0 || value > kByteMax) {
-          return fmt::format("command number {} is out of range (0..{})", value, kByteMax);
+          return Error{fmt::format("command number {} is out of range (0..{})", value, kByteMax)};
         }
         instruction.command = static_cast<uint8_t>(value);
-        return std::nullopt;
+        return {};
       };
       failure = evaluate_and_store(text, words[i], {}, options, kNames[i], store_command);
     } else {
@@ -200,7 +200,7 @@ std::string operand_label(const OperandSpec& operand) {
 std::variant<Instruction, Failure> parse(std::string_view text, const ParseOptions& options) {
   std::variant<std::vector<std::string_view>, Failure> split = split_words(text);
   if (Failure* failure = std::get_if<Failure>(&split)) return std::move(*failure);
-  const std::vector<std::string_view>& words = std::get<std::vector<std::string_view>>(split);
+  const std::vector<std::string_view>& words = *std::get_if<std::vector<std::string_view>>(&split);
   if (words.empty()) {
     return Failure{"empty instruction: expected a mnemonic (such as MVP, SAP, GAP) or a command number",
                    ParseErrorKind::kSyntax, 0, 0};
@@ -304,7 +304,7 @@ Result<Instruction> parse_instruction(std::string_view text, const ParseOptions&
     if (options.error_detail != nullptr) *options.error_detail = {failure->kind, failure->offset, failure->length};
     return Error{std::move(failure->message)};
   }
-  return std::get<Instruction>(parsed);
+  return *std::get_if<Instruction>(&parsed);
 }
 
 std::string format_instruction(const Instruction& instruction) {

@@ -14,7 +14,7 @@
 
 #include "core/tmcl/instruction.h"
 #include "core/tmcl/mnemonic_table.h"
-#include "tools/result.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 

@@ -33,10 +33,10 @@ Bytes concat(std::initializer_list<Bytes> parts) {
 class AsciiModeTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    TmclTcpServer::OpenResult opened = TmclTcpServer::open(rig_.runtime->loop(), rig_.runtime->service(),
-                                                           TcpEndpointSpec{"127.0.0.1", 0}, [](const std::string&) {});
-    ASSERT_TRUE(opened.server) << opened.error;
-    server_ = std::move(opened.server);
+    Result<std::unique_ptr<TmclTcpServer>> opened = TmclTcpServer::open(
+        rig_.runtime->loop(), rig_.runtime->service(), TcpEndpointSpec{"127.0.0.1", 0}, [](const std::string&) {});
+    ASSERT_TRUE(opened) << opened.error();
+    server_ = std::move(*opened);
   }
   Bytes receive(TcpTestClient& client, size_t count) {
     EXPECT_TRUE(testing::pump_until([this] { rig_.step(); }, [&] { return client.has(count); }))

@@ -100,11 +100,12 @@ TEST(HostRuntimeBusyPoll, can_frames_from_a_socketcand_client_open_the_window_of
   ASSERT_FALSE(runtime.has_tmcl_service());
   CanBus bus([&group] { return group.sim_time_us(); });
   for (ModuleGroup::Member& member : group.members()) member.module->can_node()->connect(bus);
-  SocketcandServer::OpenResult opened = SocketcandServer::open(runtime.loop(), bus, TcpEndpointSpec{"127.0.0.1", 0}, quiet);
-  ASSERT_TRUE(opened.server) << opened.error;
+  Result<std::unique_ptr<SocketcandServer>> opened =
+      SocketcandServer::open(runtime.loop(), bus, TcpEndpointSpec{"127.0.0.1", 0}, quiet);
+  ASSERT_TRUE(opened) << opened.error();
   runtime.start();
 
-  testing::TcpTestClient client(opened.server->local_port());
+  testing::TcpTestClient client((*opened)->local_port());
   ASSERT_TRUE(client.connected());
   std::string received;
   const auto step = [&] {

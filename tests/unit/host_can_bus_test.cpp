@@ -99,30 +99,29 @@ TEST(Socketcand, element_parser_tolerates_garbage) {
 }
 
 TEST(Socketcand, parses_python_can_send_elements) {
-  std::string error;
   // python-can 4.1.0: unpadded lowercase hex data, uppercase ID and length.
-  std::optional<can::CanFrame> f = parse_socketcand_send(socketcand_words(" send 601 8 40 0 10 0 0 0 0 0 "), error);
-  ASSERT_TRUE(f) << error;
+  Result<can::CanFrame> f = parse_socketcand_send(socketcand_words(" send 601 8 40 0 10 0 0 0 0 0 "));
+  ASSERT_TRUE(f) << f.error();
   EXPECT_EQ(*f, frame(0x601, {0x40, 0, 0x10, 0, 0, 0, 0, 0}));
   EXPECT_FALSE(f->extended);
-  f = parse_socketcand_send(socketcand_words(" send 80 0  "), error);  // empty frame
-  ASSERT_TRUE(f) << error;
+  f = parse_socketcand_send(socketcand_words(" send 80 0  "));  // empty frame
+  ASSERT_TRUE(f) << f.error();
   EXPECT_EQ(f->dlc, 0);
-  f = parse_socketcand_send(socketcand_words("send 1FFFFFFF 2 ab CD"), error);
-  ASSERT_TRUE(f) << error;
+  f = parse_socketcand_send(socketcand_words("send 1FFFFFFF 2 ab CD"));
+  ASSERT_TRUE(f) << f.error();
   EXPECT_TRUE(f->extended);
   EXPECT_EQ(f->data[0], 0xAB);
   EXPECT_EQ(f->data[1], 0xCD);
-  f = parse_socketcand_send(socketcand_words("send 00000123 0"), error);  // 8 digits: extended
-  ASSERT_TRUE(f) << error;
+  f = parse_socketcand_send(socketcand_words("send 00000123 0"));  // 8 digits: extended
+  ASSERT_TRUE(f) << f.error();
   EXPECT_TRUE(f->extended);
   EXPECT_EQ(f->id, 0x123u);
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 2 40"), error));
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 9 1 2 3 4 5 6 7 8 9"), error));
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 20000000 0"), error));
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send xyz 0"), error));
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 1 100"), error));
-  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601"), error));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 2 40")));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 9 1 2 3 4 5 6 7 8 9")));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 20000000 0")));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send xyz 0")));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601 1 100")));
+  EXPECT_FALSE(parse_socketcand_send(socketcand_words("send 601")));
 }
 
 TEST(Socketcand, formats_frames_with_a_space_before_each) {
@@ -135,29 +134,28 @@ TEST(Socketcand, formats_frames_with_a_space_before_each) {
 }
 
 TEST(Socketcand, can_endpoint_specs) {
-  std::string error;
-  std::optional<CanEndpointSpec> spec = parse_can_endpoint("socketcand", error);
+  Result<CanEndpointSpec> spec = parse_can_endpoint("socketcand");
   ASSERT_TRUE(spec);
   EXPECT_EQ(spec->tcp.host, "127.0.0.1");
   EXPECT_EQ(spec->tcp.port, 29536);
-  spec = parse_can_endpoint("socketcand:127.0.0.1:0", error);
+  spec = parse_can_endpoint("socketcand:127.0.0.1:0");
   ASSERT_TRUE(spec);
   EXPECT_EQ(spec->tcp.port, 0);
-  spec = parse_can_endpoint("socketcand:4000", error);
+  spec = parse_can_endpoint("socketcand:4000");
   ASSERT_TRUE(spec);
   EXPECT_EQ(spec->tcp.port, 4000);
-  spec = parse_can_endpoint("slcan:/tmp/x", error);
-  ASSERT_TRUE(spec) << error;
+  spec = parse_can_endpoint("slcan:/tmp/x");
+  ASSERT_TRUE(spec) << spec.error();
   EXPECT_EQ(spec->transport, CanTransport::kSlcanPty);
   EXPECT_EQ(spec->device, "/tmp/x");
-  spec = parse_can_endpoint("socketcan:vcan0", error);
-  ASSERT_TRUE(spec) << error;
+  spec = parse_can_endpoint("socketcan:vcan0");
+  ASSERT_TRUE(spec) << spec.error();
   EXPECT_EQ(spec->transport, CanTransport::kSocketcan);
   EXPECT_EQ(spec->device, "vcan0");
-  EXPECT_FALSE(parse_can_endpoint("slcan", error));
-  EXPECT_FALSE(parse_can_endpoint("socketcan:", error));
-  EXPECT_FALSE(parse_can_endpoint("kvaser:0", error));
-  EXPECT_FALSE(parse_can_endpoint("socketcand:1.2.3.4:99999", error));
+  EXPECT_FALSE(parse_can_endpoint("slcan"));
+  EXPECT_FALSE(parse_can_endpoint("socketcan:"));
+  EXPECT_FALSE(parse_can_endpoint("kvaser:0"));
+  EXPECT_FALSE(parse_can_endpoint("socketcand:1.2.3.4:99999"));
 }
 
 TEST(Slcan, frames_round_trip_through_the_text_form) {
@@ -250,10 +248,10 @@ TEST(SocketcandServer, serves_an_sdo_exchange_and_never_echoes) {
   EventLoop loop;
   CanBus bus([&module] { return module.sim_time_us(); });
   module.can_node()->connect(bus);
-  SocketcandServer::OpenResult opened =
+  Result<std::unique_ptr<SocketcandServer>> opened =
       SocketcandServer::open(loop, bus, TcpEndpointSpec{"127.0.0.1", 0}, [](const std::string&) {});
-  ASSERT_TRUE(opened.server) << opened.error;
-  testing::TcpTestClient client(opened.server->local_port());
+  ASSERT_TRUE(opened) << opened.error();
+  testing::TcpTestClient client((*opened)->local_port());
   ASSERT_TRUE(client.connected());
   std::string received;
   auto step = [&] {
@@ -274,7 +272,7 @@ TEST(SocketcandServer, serves_an_sdo_exchange_and_never_echoes) {
   ASSERT_TRUE(testing::pump_until(step, [&] { return has(" < frame 583 "); })) << received;
   EXPECT_TRUE(has(" < frame 583 2.500000 43181002900C0000 >")) << received;
   EXPECT_FALSE(has("frame 603")) << "the client's own frame came back: " << received;
-  EXPECT_EQ(opened.server->client_count(), 1u);
+  EXPECT_EQ((*opened)->client_count(), 1u);
   module.can_node()->disconnect();
 }
 

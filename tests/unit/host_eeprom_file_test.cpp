@@ -51,12 +51,21 @@ std::vector<uint8_t> payload_of(const std::vector<uint8_t>& file) {
 }
 
 struct Opened {
-  EepromFile::OpenResult result;
+  struct {
+    std::unique_ptr<EepromFile> file;
+    std::string error;  // when file is null
+  } result;
   std::vector<std::string> log;
 };
 Opened open_in(const std::filesystem::path& dir, const EepromImageIdentity& id = identity()) {
   Opened opened;
-  opened.result = EepromFile::open(dir, id, factory, [&opened](const std::string& line) { opened.log.push_back(line); });
+  Result<std::unique_ptr<EepromFile>> result =
+      EepromFile::open(dir, id, factory, [&opened](const std::string& line) { opened.log.push_back(line); });
+  if (result) {
+    opened.result.file = std::move(*result);
+  } else {
+    opened.result.error = result.error();
+  }
   return opened;
 }
 
@@ -77,7 +86,7 @@ TEST(EepromFile, a_missing_file_is_created_with_the_factory_image) {
   EXPECT_TRUE(opened.log.empty());
   EXPECT_EQ(std::vector<uint8_t>(file.data(), file.data() + file.size()), factory_bytes());
   const std::vector<uint8_t> on_disk = read_all(file.path());
-  EXPECT_EQ(EepromFile::validate(identity(), on_disk), "");
+  EXPECT_EQ(EepromFile::validate(identity(), on_disk).error(), "");
   EXPECT_EQ(payload_of(on_disk), factory_bytes());
 }
 
@@ -181,7 +190,7 @@ TEST(EepromFile, damaged_or_foreign_images_give_one_log_line_and_the_factory_ima
     EXPECT_EQ(std::vector<uint8_t>(opened.result.file->data(), opened.result.file->data() + kPayloadSize),
               factory_bytes());
     EXPECT_EQ(read_all(path.string() + ".damaged"), bad);
-    EXPECT_EQ(EepromFile::validate(identity(), read_all(path)), "");
+    EXPECT_EQ(EepromFile::validate(identity(), read_all(path)).error(), "");
   }
 }
 
@@ -221,7 +230,7 @@ TEST(EepromFile, a_failed_directory_sync_reports_failure_yet_leaves_a_complete_i
   const uint8_t value[1] = {0x11};
   EXPECT_FALSE(file.write(0, value, 1));
   EXPECT_EQ(file.data()[0], factory_bytes()[0]);
-  EXPECT_EQ(EepromFile::validate(identity(), read_all(file.path())), "");
+  EXPECT_EQ(EepromFile::validate(identity(), read_all(file.path())).error(), "");
 }
 
 TEST(EepromFile, a_write_where_no_file_can_be_created_fails_and_keeps_the_old_file) {

@@ -31,7 +31,7 @@ using namespace std::chrono_literals;
 
 tools::CompletedProcess run_motwin(std::vector<std::string> arguments) {
   arguments.insert(arguments.begin(), MOTWIN_BINARY);
-  tools::Result<tools::CompletedProcess> completed = tools::ChildProcess::run(arguments, 30s);
+  Result<tools::CompletedProcess> completed = tools::ChildProcess::run(arguments, 30s);
   if (!completed) ADD_FAILURE() << completed.error();
   return completed ? completed.value() : tools::CompletedProcess{-1, {}};
 }
@@ -155,7 +155,7 @@ TEST(ModuleDescriptors, serve_starts_each_module_and_prints_its_firmware) {
   for (const ModuleDescriptor& module : registered_modules()) {
     SCOPED_TRACE(name_of(module));
     const bool on_tcp = module.endpoints.default_endpoint == DefaultEndpoint::kTmclTcp;
-    tools::Result<tools::ChildProcess> serve = tools::ChildProcess::spawn(
+    Result<tools::ChildProcess> serve = tools::ChildProcess::spawn(
         {MOTWIN_BINARY, "serve", "--module", name_of(module), "--state-dir", "none", "--speed", "fast",
          on_tcp ? "--tmcl-tcp" : "--can", on_tcp ? "127.0.0.1:0" : "socketcand:127.0.0.1:0"});
     ASSERT_TRUE(serve) << serve.error();
@@ -172,7 +172,7 @@ TEST(ModuleDescriptors, serve_starts_each_module_and_prints_its_firmware) {
 }
 
 TEST(ModuleDescriptors, run_traces_the_default_columns_of_tmcl_modules_and_refuses_the_others) {
-  tools::Result<tools::TemporaryDirectory> directory = tools::TemporaryDirectory::create("motwin-descriptor");
+  Result<tools::TemporaryDirectory> directory = tools::TemporaryDirectory::create("motwin-descriptor");
   ASSERT_TRUE(directory) << directory.error();
   const std::string program = (directory->path() / "stop.tmc").string();
   std::ofstream(program) << "STOP\n";

@@ -11,18 +11,19 @@ constexpr uint32_t kTickUs = 50;
 constexpr uint64_t kWall0 = 1'000'000;
 
 TEST(Pacing, parses_modes_and_factors) {
-  std::string error;
-  EXPECT_EQ(Pacing::parse("realtime", error)->mode, Pacing::Mode::kPaced);
-  EXPECT_EQ(Pacing::parse("realtime", error)->speed_factor, 1.0);
-  EXPECT_EQ(Pacing::parse("fast", error)->mode, Pacing::Mode::kFast);
-  EXPECT_EQ(Pacing::parse("2", error)->speed_factor, 2.0);
-  EXPECT_EQ(Pacing::parse("0.5", error)->speed_factor, 0.5);
-  EXPECT_EQ(Pacing::parse("0.5", error)->describe(), "x0.5");
-  EXPECT_EQ(Pacing::parse("1", error)->describe(), "realtime");
+  EXPECT_EQ(Pacing::parse("realtime")->mode, Pacing::Mode::kPaced);
+  EXPECT_EQ(Pacing::parse("realtime")->speed_factor, 1.0);
+  EXPECT_EQ(Pacing::parse("fast")->mode, Pacing::Mode::kFast);
+  EXPECT_EQ(Pacing::parse("2")->speed_factor, 2.0);
+  EXPECT_EQ(Pacing::parse("0.5")->speed_factor, 0.5);
+  EXPECT_EQ(Pacing::parse("0.5")->describe(), "x0.5");
+  EXPECT_EQ(Pacing::parse("1")->describe(), "realtime");
   for (const char* bad : {"0", "-1", "abc", "", "1e9", "Fast"}) {
     SCOPED_TRACE(bad);
-    EXPECT_FALSE(Pacing::parse(bad, error));
-    EXPECT_EQ(error, "--speed takes realtime, fast or a factor from 0.001 to 10000, got \"" + std::string(bad) + "\"");
+    const Result<Pacing> parsed = Pacing::parse(bad);
+    EXPECT_FALSE(parsed);
+    EXPECT_EQ(parsed.error(),
+              "--speed takes realtime, fast or a factor from 0.001 to 10000, got \"" + std::string(bad) + "\"");
   }
 }
 

@@ -73,20 +73,18 @@ TEST(PersistCrashPoint, takes_each_step_name_with_and_without_a_write_number) {
       {"sync-directory", PersistStep::kSyncDirectory}};
   for (const auto& [name, step] : steps) {
     SCOPED_TRACE(name);
-    std::string error;
-    std::optional<PersistCrashPoint> point = parse_persist_crash_point(name, error);
-    ASSERT_TRUE(point) << error;
+    Result<PersistCrashPoint> point = parse_persist_crash_point(name);
+    ASSERT_TRUE(point) << point.error();
     EXPECT_EQ(point->step, step);
     EXPECT_EQ(point->persist_number, 1u);
     EXPECT_EQ(persist_step_name(step), name);
-    point = parse_persist_crash_point(std::string(name) + ":7", error);
-    ASSERT_TRUE(point) << error;
+    point = parse_persist_crash_point(std::string(name) + ":7");
+    ASSERT_TRUE(point) << point.error();
     EXPECT_EQ(point->step, step);
     EXPECT_EQ(point->persist_number, 7u);
   }
-  std::string error;
-  const std::optional<PersistCrashPoint> largest = parse_persist_crash_point("rename:1000000000", error);
-  ASSERT_TRUE(largest) << error;
+  const Result<PersistCrashPoint> largest = parse_persist_crash_point("rename:1000000000");
+  ASSERT_TRUE(largest) << largest.error();
   EXPECT_EQ(largest->persist_number, 1'000'000'000u);
 }
 
@@ -97,9 +95,9 @@ TEST(PersistCrashPoint, refuses_anything_else_with_a_message_naming_the_variable
                               "rename:99999999999999999999"};
   for (const char* value : bad_values) {
     SCOPED_TRACE(value);
-    std::string error;
-    EXPECT_FALSE(parse_persist_crash_point(value, error));
-    EXPECT_EQ(error, std::string("MOTWIN_CRASH_AT_PERSIST_STEP=\"") + value +
+    const Result<PersistCrashPoint> point = parse_persist_crash_point(value);
+    EXPECT_FALSE(point);
+    EXPECT_EQ(point.error(), std::string("MOTWIN_CRASH_AT_PERSIST_STEP=\"") + value +
                          "\": expected STEP or STEP:N with STEP one of open-temporary, write-temporary, "
                          "sync-temporary, rename, sync-directory and N the image write to crash in (1 to 1000000000)");
   }
@@ -107,20 +105,21 @@ TEST(PersistCrashPoint, refuses_anything_else_with_a_message_naming_the_variable
 
 TEST(PersistCrashPoint, unset_or_empty_variable_installs_nothing_and_a_bad_one_is_an_error) {
   CrashVariable variable;
-  std::string error;
   variable.unset();
-  EXPECT_TRUE(install_persist_crash_hook_from_environment(error));
+  EXPECT_TRUE(install_persist_crash_hook_from_environment());
   variable.set("");
-  EXPECT_TRUE(install_persist_crash_hook_from_environment(error));
-  EXPECT_EQ(error, "");
+  const Result<void> installed = install_persist_crash_hook_from_environment();
+  EXPECT_TRUE(installed);
+  EXPECT_EQ(installed.error(), "");
   variable.set("rename:zero");
-  EXPECT_FALSE(install_persist_crash_hook_from_environment(error));
-  EXPECT_NE(error.find("MOTWIN_CRASH_AT_PERSIST_STEP=\"rename:zero\""), std::string::npos) << error;
+  const Result<void> refused = install_persist_crash_hook_from_environment();
+  EXPECT_FALSE(refused);
+  EXPECT_NE(refused.error().find("MOTWIN_CRASH_AT_PERSIST_STEP=\"rename:zero\""), std::string::npos) << refused.error();
   // Nothing was installed: this process still writes images (a crash hook would kill the test).
   ScratchDirectory scratch;
-  EepromFile::OpenResult opened = EepromFile::open(scratch.path(), kIdentity, fill_factory_image);
-  ASSERT_TRUE(opened.file) << opened.error;
-  EXPECT_TRUE(opened.file->write(0, kNewBytes, sizeof kNewBytes));
+  Result<std::unique_ptr<EepromFile>> opened = EepromFile::open(scratch.path(), kIdentity, fill_factory_image);
+  ASSERT_TRUE(opened) << opened.error();
+  EXPECT_TRUE((*opened)->write(0, kNewBytes, sizeof kNewBytes));
 }
 
 // What a crash just before each step leaves on disk: the temporary file as far as the write got,
@@ -148,11 +147,10 @@ TEST(PersistCrashPoint, the_process_dies_by_sigkill_just_before_the_step_of_the_
     variable.set(outcome.variable_value);
     EXPECT_EXIT(
         {
-          std::string error;
-          if (!install_persist_crash_hook_from_environment(error)) std::_Exit(3);
-          EepromFile::OpenResult opened = EepromFile::open(scratch.path(), kIdentity, fill_factory_image);
-          if (!opened.file) std::_Exit(4);
-          opened.file->write(0, kNewBytes, sizeof kNewBytes);
+          if (!install_persist_crash_hook_from_environment()) std::_Exit(3);
+          Result<std::unique_ptr<EepromFile>> opened = EepromFile::open(scratch.path(), kIdentity, fill_factory_image);
+          if (!opened) std::_Exit(4);
+          (*opened)->write(0, kNewBytes, sizeof kNewBytes);
           std::_Exit(0);  // not reached when the hook fires
         },
         ::testing::KilledBySignal(SIGKILL), "");
@@ -172,8 +170,7 @@ TEST(PersistCrashPoint, the_first_write_of_the_process_is_the_default) {
   variable.set("rename");
   EXPECT_EXIT(
       {
-        std::string error;
-        if (!install_persist_crash_hook_from_environment(error)) std::_Exit(3);
+        if (!install_persist_crash_hook_from_environment()) std::_Exit(3);
         (void)EepromFile::open(scratch.path(), kIdentity, fill_factory_image);  // write 1: the factory image
         std::_Exit(0);
       },

@@ -56,10 +56,10 @@ class PtyEndpointTest : public ::testing::Test {
   std::string link() const { return (scratch_.path() / "tmcm1636").string(); }
 
   void open_endpoint() {
-    TmclPtyEndpoint::OpenResult opened =
+    Result<std::unique_ptr<TmclPtyEndpoint>> opened =
         TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link(), [](const std::string&) {});
-    ASSERT_TRUE(opened.endpoint) << opened.error;
-    endpoint_ = std::move(opened.endpoint);
+    ASSERT_TRUE(opened) << opened.error();
+    endpoint_ = std::move(*opened);
   }
   Bytes exchange(SerialTestClient& client, const Bytes& frame) {
     client.send(frame);
@@ -156,25 +156,27 @@ TEST_F(PtyEndpointTest, a_stale_link_is_replaced_and_removed_at_shutdown) {
 
 TEST_F(PtyEndpointTest, a_regular_file_or_a_link_to_something_else_is_not_replaced) {
   std::ofstream(link()) << "precious";
-  TmclPtyEndpoint::OpenResult opened = TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
-  EXPECT_FALSE(opened.endpoint);
-  EXPECT_EQ(opened.error, link() + " exists and is not a symbolic link; not replacing it");
+  Result<std::unique_ptr<TmclPtyEndpoint>> opened =
+      TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
+  EXPECT_FALSE(opened);
+  EXPECT_EQ(opened.error(), link() + " exists and is not a symbolic link; not replacing it");
   std::filesystem::remove(link());
 
   const std::string target = (scratch_.path() / "real-device").string();
   std::ofstream(target) << "x";
   std::filesystem::create_symlink(target, link());
   opened = TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
-  EXPECT_FALSE(opened.endpoint);
-  EXPECT_EQ(opened.error, link() + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it");
+  EXPECT_FALSE(opened);
+  EXPECT_EQ(opened.error(),
+            link() + " is a symbolic link to " + target + ", not to a pseudo-terminal; not replacing it");
   EXPECT_EQ(std::filesystem::read_symlink(link()).string(), target);
 }
 
 TEST_F(PtyEndpointTest, a_link_in_a_missing_directory_is_an_error) {
-  TmclPtyEndpoint::OpenResult opened =
+  Result<std::unique_ptr<TmclPtyEndpoint>> opened =
       TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), (scratch_.path() / "no" / "tty").string());
-  EXPECT_FALSE(opened.endpoint);
-  EXPECT_NE(opened.error.find("No such file or directory"), std::string::npos) << opened.error;
+  EXPECT_FALSE(opened);
+  EXPECT_NE(opened.error().find("No such file or directory"), std::string::npos) << opened.error();
 }
 
 }  // namespace

@@ -23,11 +23,11 @@ constexpr int32_t kDefaultMaxVelocity = 4000;  // AP 43 factory default
 class TcpServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    TmclTcpServer::OpenResult opened = TmclTcpServer::open(rig_.runtime->loop(), rig_.runtime->service(),
-                                                           TcpEndpointSpec{"127.0.0.1", 0},
-                                                           [this](const std::string& line) { log_.push_back(line); });
-    ASSERT_TRUE(opened.server) << opened.error;
-    server_ = std::move(opened.server);
+    Result<std::unique_ptr<TmclTcpServer>> opened =
+        TmclTcpServer::open(rig_.runtime->loop(), rig_.runtime->service(), TcpEndpointSpec{"127.0.0.1", 0},
+                            [this](const std::string& line) { log_.push_back(line); });
+    ASSERT_TRUE(opened) << opened.error();
+    server_ = std::move(*opened);
   }
 
   // Pumps the loop until `client` holds `count` bytes, then returns them.
@@ -50,18 +50,17 @@ class TcpServerTest : public ::testing::Test {
 };
 
 TEST(TcpEndpointSpec, parses_host_and_port) {
-  std::string error;
-  EXPECT_EQ(parse_tcp_endpoint("127.0.0.1:5000", error)->host, "127.0.0.1");
-  EXPECT_EQ(parse_tcp_endpoint("127.0.0.1:5000", error)->port, 5000);
-  EXPECT_EQ(parse_tcp_endpoint("0.0.0.0:0", error)->port, 0);
-  EXPECT_EQ(parse_tcp_endpoint(":6000", error)->host, "127.0.0.1");
-  EXPECT_EQ(parse_tcp_endpoint("6000", error)->port, 6000);
-  EXPECT_EQ(parse_tcp_endpoint("localhost:1", error)->host, "localhost");
-  EXPECT_EQ(parse_tcp_endpoint("[::1]:7000", error)->host, "::1");
-  EXPECT_EQ(parse_tcp_endpoint("[::1]:7000", error)->port, 7000);
+  EXPECT_EQ(parse_tcp_endpoint("127.0.0.1:5000")->host, "127.0.0.1");
+  EXPECT_EQ(parse_tcp_endpoint("127.0.0.1:5000")->port, 5000);
+  EXPECT_EQ(parse_tcp_endpoint("0.0.0.0:0")->port, 0);
+  EXPECT_EQ(parse_tcp_endpoint(":6000")->host, "127.0.0.1");
+  EXPECT_EQ(parse_tcp_endpoint("6000")->port, 6000);
+  EXPECT_EQ(parse_tcp_endpoint("localhost:1")->host, "localhost");
+  EXPECT_EQ(parse_tcp_endpoint("[::1]:7000")->host, "::1");
+  EXPECT_EQ(parse_tcp_endpoint("[::1]:7000")->port, 7000);
   for (const char* bad : {"127.0.0.1:65536", "127.0.0.1:", "127.0.0.1:x", "", "[::1]"}) {
     SCOPED_TRACE(bad);
-    EXPECT_FALSE(parse_tcp_endpoint(bad, error));
+    EXPECT_FALSE(parse_tcp_endpoint(bad));
   }
 }
 
@@ -71,10 +70,10 @@ TEST_F(TcpServerTest, port_zero_picks_a_free_port_on_the_loopback_address) {
 }
 
 TEST_F(TcpServerTest, a_port_in_use_is_a_clear_error) {
-  TmclTcpServer::OpenResult second = TmclTcpServer::open(rig_.runtime->loop(), rig_.runtime->service(),
-                                                         TcpEndpointSpec{"127.0.0.1", server_->local_port()});
-  EXPECT_FALSE(second.server);
-  EXPECT_EQ(second.error, "cannot listen on " + server_->local_address() + ": Address already in use");
+  Result<std::unique_ptr<TmclTcpServer>> second = TmclTcpServer::open(
+      rig_.runtime->loop(), rig_.runtime->service(), TcpEndpointSpec{"127.0.0.1", server_->local_port()});
+  EXPECT_FALSE(second);
+  EXPECT_EQ(second.error(), "cannot listen on " + server_->local_address() + ": Address already in use");
 }
 
 TEST_F(TcpServerTest, answers_a_gap_frame_with_the_exact_reply_bytes) {

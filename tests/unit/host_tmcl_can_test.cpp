@@ -340,8 +340,9 @@ TEST(SlcanPtyEndpoint, a_client_on_the_pty_exchanges_frames_with_the_bus) {
   Recorder node;
   const CanBus::EndpointId node_id = bus.attach(node);
   const std::string link = ::testing::TempDir() + "motwin-slcan-test-" + std::to_string(::getpid());
-  SlcanPtyEndpoint::OpenResult opened = SlcanPtyEndpoint::open(loop, bus, link, [](const std::string&) {});
-  ASSERT_TRUE(opened.endpoint) << opened.error;
+  Result<std::unique_ptr<SlcanPtyEndpoint>> opened =
+      SlcanPtyEndpoint::open(loop, bus, link, [](const std::string&) {});
+  ASSERT_TRUE(opened) << opened.error();
   const int client = ::open(link.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   ASSERT_GE(client, 0);
   std::string received;
@@ -365,7 +366,7 @@ TEST(SlcanPtyEndpoint, a_client_on_the_pty_exchanges_frames_with_the_bus) {
   bus.send(node_id, frame(0x581, {0x43, 0x00, 0x10}));
   ASSERT_TRUE(testing::pump_until(step, [&] { return received == "t5813430010\r"; })) << received;
   ::close(client);
-  opened.endpoint.reset();
+  opened->reset();
   EXPECT_NE(::access(link.c_str(), F_OK), 0) << "the link must go with the endpoint";
 }
 
@@ -389,15 +390,16 @@ TEST(SocketcanEndpoint, fails_with_a_clear_message_where_there_is_no_af_can) {
   if (probe >= 0) {
     ::close(probe);
     // With kernel CAN, an interface that does not exist is refused by name.
-    SocketcanEndpoint::OpenResult opened =
+    Result<std::unique_ptr<SocketcanEndpoint>> opened =
         SocketcanEndpoint::open(loop, bus, "motwinnone0", [](const std::string&) {});
-    EXPECT_FALSE(opened.endpoint);
-    EXPECT_NE(opened.error.find("no such CAN interface"), std::string::npos) << opened.error;
+    EXPECT_FALSE(opened);
+    EXPECT_NE(opened.error().find("no such CAN interface"), std::string::npos) << opened.error();
     return;
   }
-  SocketcanEndpoint::OpenResult opened = SocketcanEndpoint::open(loop, bus, "vcan0", [](const std::string&) {});
-  EXPECT_FALSE(opened.endpoint);
-  EXPECT_NE(opened.error.find("no SocketCAN"), std::string::npos) << opened.error;
+  Result<std::unique_ptr<SocketcanEndpoint>> opened =
+      SocketcanEndpoint::open(loop, bus, "vcan0", [](const std::string&) {});
+  EXPECT_FALSE(opened);
+  EXPECT_NE(opened.error().find("no SocketCAN"), std::string::npos) << opened.error();
   EXPECT_EQ(bus.endpoint_count(), 0u);
 }
 

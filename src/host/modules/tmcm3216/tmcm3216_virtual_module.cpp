@@ -22,7 +22,8 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
     return result;
   }
   std::unique_ptr<Tmcm3216VirtualModule> module(new Tmcm3216VirtualModule());
-  if (!module->eeprom_.open(options, eeprom_identity(), &Device::format_factory_image, result.error)) return result;
+  const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), &Device::format_factory_image);
+  if (!eeprom) return MakeModuleResult{nullptr, eeprom.error()};
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
   config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
