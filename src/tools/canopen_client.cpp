@@ -108,7 +108,7 @@ Result<std::unique_ptr<SocketcandClient>> SocketcandClient::connect(const std::s
 
 SocketcandClient::~SocketcandClient() { ::close(fd_); }
 
-bool SocketcandClient::send(const can::CanFrame& frame) {
+Result<void> SocketcandClient::send(const can::CanFrame& frame) {
   char head[40];
   std::snprintf(head, sizeof(head), frame.extended ? "< send %08X %u" : "< send %03X %u", static_cast<unsigned>(frame.id),
                 static_cast<unsigned>(frame.dlc));
@@ -119,7 +119,10 @@ bool SocketcandClient::send(const can::CanFrame& frame) {
     text += byte;
   }
   text += " >";
-  return ::send(fd_, text.data(), text.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(text.size());
+  if (::send(fd_, text.data(), text.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(text.size())) {
+    return Error{"cannot send to the socketcand server"};
+  }
+  return {};
 }
 
 std::optional<std::string> SocketcandClient::element(int timeout_ms) {
@@ -168,8 +171,8 @@ namespace {
 // Sends `request` to 0x600 + node and waits for the next frame on 0x580 + node.
 std::optional<can::CanFrame> exchange(SocketcandClient& bus, uint8_t node, const uint8_t (&request)[8], int timeout_ms,
                                       SdoResult& result) {
-  if (!bus.send(can::make_frame(0x600u + node, request, 8))) {
-    result.error = "cannot send to the socketcand server";
+  if (const Result<void> sent = bus.send(can::make_frame(0x600u + node, request, 8)); !sent) {
+    result.error = sent.error();
     return std::nullopt;
   }
   const int64_t deadline = now_ms() + timeout_ms;

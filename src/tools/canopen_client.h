@@ -28,7 +28,8 @@ class SocketcandClient {
   SocketcandClient(const SocketcandClient&) = delete;
   SocketcandClient& operator=(const SocketcandClient&) = delete;
 
-  bool send(const can::CanFrame& frame);
+  // Fails with "cannot send to the socketcand server" when the connection refuses the frame.
+  Result<void> send(const can::CanFrame& frame);
   // The next frame from the bus, or nullopt after `timeout_ms`.
   std::optional<can::CanFrame> receive(int timeout_ms);
   std::optional<ReceivedFrame> receive_stamped(int timeout_ms);

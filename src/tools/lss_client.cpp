@@ -33,9 +33,17 @@ uint32_t get_u32(const can::CanFrame& frame, size_t at) {
   return value;
 }
 
+// The outcome of a service CiA-305 leaves unanswered: whether its frame went out.
+LssResult sent_only(const Result<void>& sent) {
+  LssResult result;
+  result.ok = sent.ok();
+  result.error = sent.error();
+  return result;
+}
+
 }  // namespace
 
-bool LssMaster::send(const std::array<uint8_t, 8>& data) {
+Result<void> LssMaster::send(const std::array<uint8_t, 8>& data) {
   // Answers that arrived late (several slaves answer one fastscan probe, or a configure) must
   // not pass for answers to this request.
   while (bus_.receive(kSettleMs)) {
@@ -56,8 +64,8 @@ std::optional<can::CanFrame> LssMaster::await(uint8_t command, int timeout_ms) {
 
 LssResult LssMaster::confirmed(const std::array<uint8_t, 8>& request, const char* what) {
   LssResult result;
-  if (!send(request)) {
-    result.error = "cannot send to the socketcand server";
+  if (const Result<void> sent = send(request); !sent) {
+    result.error = sent.error();
     return result;
   }
   const std::optional<can::CanFrame> answer = await(request[0], timeout_ms_);
@@ -77,10 +85,7 @@ LssResult LssMaster::confirmed(const std::array<uint8_t, 8>& request, const char
 }
 
 LssResult LssMaster::switch_global(bool configuration) {
-  LssResult result;
-  result.ok = send({kSwitchGlobal, static_cast<uint8_t>(configuration ? 1 : 0), 0, 0, 0, 0, 0, 0});
-  if (!result.ok) result.error = "cannot send to the socketcand server";
-  return result;
+  return sent_only(send({kSwitchGlobal, static_cast<uint8_t>(configuration ? 1 : 0), 0, 0, 0, 0, 0, 0}));
 }
 
 LssResult LssMaster::switch_selective(const LssIdentityNumbers& identity) {
@@ -89,8 +94,8 @@ LssResult LssMaster::switch_selective(const LssIdentityNumbers& identity) {
   for (uint8_t i = 0; i < 4; ++i) {
     std::array<uint8_t, 8> data{static_cast<uint8_t>(kSwitchSelectiveVendor + i)};
     put_u32(data, 1, parts[i]);
-    if (!send(data)) {
-      result.error = "cannot send to the socketcand server";
+    if (const Result<void> sent = send(data); !sent) {
+      result.error = sent.error();
       return result;
     }
   }
@@ -111,11 +116,8 @@ LssResult LssMaster::configure_bit_timing(uint8_t table_index) {
 }
 
 LssResult LssMaster::activate_bit_timing(uint16_t switch_delay_ms) {
-  LssResult result;
-  result.ok = send({kActivateBitTiming, static_cast<uint8_t>(switch_delay_ms), static_cast<uint8_t>(switch_delay_ms >> 8),
-                    0, 0, 0, 0, 0});
-  if (!result.ok) result.error = "cannot send to the socketcand server";
-  return result;
+  return sent_only(send({kActivateBitTiming, static_cast<uint8_t>(switch_delay_ms),
+                         static_cast<uint8_t>(switch_delay_ms >> 8), 0, 0, 0, 0, 0}));
 }
 
 LssResult LssMaster::store_configuration() {
@@ -124,8 +126,8 @@ LssResult LssMaster::store_configuration() {
 
 LssResult LssMaster::inquire(uint8_t command) {
   LssResult result;
-  if (!send({command, 0, 0, 0, 0, 0, 0, 0})) {
-    result.error = "cannot send to the socketcand server";
+  if (const Result<void> sent = send({command, 0, 0, 0, 0, 0, 0, 0}); !sent) {
+    result.error = sent.error();
     return result;
   }
   const std::optional<can::CanFrame> answer = await(command, timeout_ms_);

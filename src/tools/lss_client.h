@@ -58,7 +58,7 @@ class LssMaster {
   static std::optional<uint8_t> bit_timing_index(uint32_t bit_rate_kbit);
 
  private:
-  bool send(const std::array<uint8_t, 8>& data);
+  Result<void> send(const std::array<uint8_t, 8>& data);
   // The next answer with command specifier `command` within `timeout_ms`.
   std::optional<can::CanFrame> await(uint8_t command, int timeout_ms);
   LssResult confirmed(const std::array<uint8_t, 8>& request, const char* what);

@@ -20,7 +20,7 @@ std::string status_text(uint8_t status) { return fmt::format("status {} ({})", s
 Result<TmclReply> exchange(TmclClient& client, const tmcl::Instruction& request, uint8_t expected_status,
                            uint8_t module_address, const std::string& what, uint8_t* unexpected_status = nullptr) {
   Result<TmclReply> reply = client.request(request, module_address);
-  if (!reply) return Error{fmt::format("{}: {}", what, reply.error())};
+  if (!reply) return reply.error_with_context(what + ": ");
   if (reply->status != expected_status) {
     if (unexpected_status != nullptr) *unexpected_status = reply->status;
     return Error{fmt::format("{}: the module answered {}, expected {}", what, status_text(reply->status),

@@ -78,7 +78,7 @@ Result<std::vector<tmcl::Instruction>> read_program_binary(const std::string& pa
   const std::vector<uint8_t> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) return Error{fmt::format("cannot read {}: {}", path, std::strerror(errno))};
   Result<std::vector<tmcl::Instruction>> decoded = decode_program_binary(bytes);
-  if (!decoded) return Error{fmt::format("{}: {}", path, decoded.error())};
+  if (!decoded) return decoded.error_with_context(path + ": ");
   return decoded;
 }
 
