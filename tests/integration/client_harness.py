@@ -117,7 +117,7 @@ def descriptor_targets(pid):
     return ", ".join(targets)
 
 
-def check_descriptors_return(pid, expected, what, timeout=10.0):
+def check_descriptors_return(pid, expected, what, timeout=60.0):
     """The server notices closed connections on its own schedule: waits (up to `timeout`) until
     it holds `expected` descriptors again, then checks."""
     deadline = time.monotonic() + timeout

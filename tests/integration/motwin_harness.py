@@ -14,6 +14,7 @@ Conventions
 import argparse
 import collections
 import ctypes
+import fcntl
 import os
 import re
 import selectors
@@ -24,6 +25,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import termios
 import threading
 import time
 import traceback
@@ -59,9 +61,12 @@ DEFAULT_REACHED_VELOCITY = 500   # AP 54
 DEFAULT_ADC_OFFSET = 32767       # AP 5, 6
 DEFAULT_AUTO_START = 1           # GP 77
 
-# Generous: the same scripts run against an ASan+UBSan build.
+# Liveness bounds, not timing requirements: the same scripts run against an ASan+UBSan build on a
+# machine whose cores other jobs keep busy, where a reply that takes 0.2 ms idle can take seconds.
+# A test that asserts an absence (expect_no_reply, read_available) says how long it waits.
 STARTUP_TIMEOUT = 30.0
-REPLY_TIMEOUT = 2.0
+REPLY_TIMEOUT = 10.0
+FRAME_TIMEOUT = 10.0  # a CAN frame the test waits for (an EMCY, a TPDO, a reply)
 STOP_TIMEOUT = 15.0
 
 
@@ -185,6 +190,20 @@ class ClientBase:
         check_equal(raw[0], HOST_ADDRESS, "136 type 0: host address")
         return bytes(raw[1:])
 
+    def wait_sim_ms(self, milliseconds):
+        """Waits until the module's own clock, GP 132 (the TMCL tick timer, milliseconds of
+        simulated time), has advanced by `milliseconds`: what time.sleep() means when the host
+        keeps up with the wall clock, which a loaded machine does not."""
+        start_ms = last_ms = self.ggp(132, BANK_GLOBAL)
+        last_progress = time.monotonic()
+        while last_ms < start_ms + milliseconds:
+            time.sleep(0.002)
+            now_ms = self.ggp(132, BANK_GLOBAL)
+            if now_ms != last_ms:
+                last_ms, last_progress = now_ms, time.monotonic()
+            elif time.monotonic() - last_progress > 60.0:
+                raise TestFailure(f"GP 132 (tick timer) stood still at {now_ms} ms for 60 s")
+
     def wait_for(self, description, predicate, timeout, interval=0.005):
         """Polls predicate() (which talks to the module) until true; returns its last value."""
         deadline = time.monotonic() + timeout
@@ -237,6 +256,13 @@ class TcpClient(ClientBase):
             return b""
         return data if data else b""
 
+    def wait_until_server_read_everything(self, timeout=60.0):
+        """Waits until the server has read every byte this client sent: nothing left in this
+        socket's send queue nor in the server's receive queue (/proc/net/tcp). A loaded server
+        (a sanitizer build, busy cores) may still be working through a burst long after the
+        client sent it; a pause meant for the server (the resync gap) only starts then."""
+        wait_until_read_by_peer(self.sock, timeout)
+
     def close(self):
         try:
             self.sock.close()
@@ -248,6 +274,57 @@ class TcpClient(ClientBase):
 
     def __exit__(self, *exc):
         self.close()
+
+
+def _unsent_bytes(sock):
+    """Bytes in the socket's send queue not yet acknowledged by the peer's kernel (SIOCOUTQ)."""
+    return struct.unpack("i", fcntl.ioctl(sock.fileno(), termios.TIOCOUTQ, b"\0" * 4))[0]
+
+
+def _proc_net_address(address):
+    """("127.0.0.1", 5000) as /proc/net/tcp writes it: 0100007F:1388."""
+    host, port = address[:2]
+    return f"{struct.unpack('<I', socket.inet_aton(host))[0]:08X}:{port:04X}"
+
+
+def _peer_receive_queue(sock):
+    """Bytes the peer process has not read yet from the connection of `sock` (both ends on this
+    host, IPv4): the rx_queue of the peer's socket in /proc/net/tcp; None if it is not listed."""
+    peer_local = _proc_net_address(sock.getpeername())
+    peer_remote = _proc_net_address(sock.getsockname())
+    with open("/proc/net/tcp") as f:
+        next(f)
+        for line in f:
+            fields = line.split()
+            if fields[1] == peer_local and fields[2] == peer_remote:
+                return int(fields[4].split(":")[1], 16)
+    return None
+
+
+def bytes_received_at(port):
+    """For each established connection of the server listening on 127.0.0.1:`port`: how many
+    bytes its client has sent that the server has read (tcp_info's bytes_received less Recv-Q,
+    from iproute2's ss)."""
+    out = subprocess.run(["ss", "-tinH", "state", "established", f"( sport = :{port} )"], capture_output=True,
+                         text=True, timeout=30, check=True).stdout.split("\n")
+    received = []
+    for head, info in zip(out[0::2], out[1::2]):
+        m = re.search(r"\bbytes_received:(\d+)", info)
+        received.append((int(m.group(1)) if m else 0) - int(head.split()[0]))
+    return received
+
+
+def wait_until_read_by_peer(sock, timeout=60.0):
+    """Waits until the other end (a server on this host) has read everything sent on `sock`."""
+    deadline = time.monotonic() + timeout
+    while True:
+        unsent, unread = _unsent_bytes(sock), _peer_receive_queue(sock)
+        if unsent == 0 and not unread:
+            return
+        if time.monotonic() > deadline:
+            raise TestFailure(f"the server has not read what it was sent after {timeout} s: {unsent} bytes "
+                              f"still to send, {unread} unread in its receive queue")
+        time.sleep(0.01)
 
 
 class SerialClient(ClientBase):
@@ -447,6 +524,26 @@ class Server:
 
     def alive(self):
         return self.proc is not None and self.proc.poll() is None
+
+    def bytes_read(self):
+        """Bytes the server process has read so far (rchar of /proc/PID/io: its pty, sockets and
+        files; a pty read in packet mode counts one status byte more)."""
+        with open(f"/proc/{self.proc.pid}/io") as f:
+            for line in f:
+                if line.startswith("rchar:"):
+                    return int(line.split()[1])
+        raise ServerError("no rchar in /proc/PID/io")
+
+    def wait_until_read(self, total, timeout=60.0):
+        """Waits until bytes_read() reaches `total` (bytes_read() before a write plus its length):
+        the server has taken in what a client wrote. A pause meant for the server (the resync gap
+        of the serial link) only starts then: a loaded server may read a burst late."""
+        deadline = time.monotonic() + timeout
+        while self.bytes_read() < total:
+            check(self.alive(), f"server died (status {self.proc.poll()}); stderr {self.stderr_text()!r}")
+            if time.monotonic() > deadline:
+                raise ServerError(f"the server read {self.bytes_read()} bytes, not {total}, within {timeout} s")
+            time.sleep(0.002)
 
     def stop(self, sig=signal.SIGTERM, timeout=STOP_TIMEOUT):
         """Sends `sig` and checks the clean exit (status 0)."""

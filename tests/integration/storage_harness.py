@@ -109,7 +109,7 @@ def read_program_values(c):
 
 # --- A request answered by a crash ----------------------------------------------------------------
 
-def tcp_bytes_until_closed(client, timeout=5.0):
+def tcp_bytes_until_closed(client, timeout=30.0):
     """What a TMCL TCP client receives until the server's end closes."""
     received = b""
     deadline = time.monotonic() + timeout

@@ -37,6 +37,14 @@ def line(client, text, expected, what=None):
     expect_text(client, expected, what or repr(text))
 
 
+def ascii_value(client, text):
+    """The value of a reply line "BA 100 VALUE" to `text` (GP 67 = 32: no echo)."""
+    client.send_raw(text.encode("latin-1"))
+    reply = client.read_exact(len("BA 100 ")) + client.port.read_until(b"\r")
+    check(reply.startswith(b"BA 100 ") and reply.endswith(b"\r"), f"reply to {text!r}: {reply!r}")
+    return int(reply.decode().split()[2])
+
+
 def enter_ascii(client):
     expect_reply(client.request(ENTER_ASCII), ENTER_ASCII, 100, 0, "139 (enter ASCII mode)")
 
@@ -123,13 +131,15 @@ def test_run_stop_and_bin(motwin):
         enter_ascii(client)
         line(client, "ARUN\r", "BA 100 0\r")
         line(client, "AGGP 128, 0\r", "BA 100 1\r", "application status after RUN: running")
-        time.sleep(0.05)
+        # 50 ms of the module's own time (GP 132, the tick timer): a loaded machine may run the
+        # module slower than the wall clock.
+        started_ms = ascii_value(client, "AGGP 132, 0\r")
+        while ascii_value(client, "AGGP 132, 0\r") < started_ms + 50:
+            time.sleep(0.005)
         line(client, "ASTOP\r", "BA 100 0\r")
         line(client, "AGGP 128, 0\r", "BA 100 0\r", "application status after STOP: stopped")
-        client.send_raw(b"AGGP 0, 2\r")
-        reply = client.read_exact(len("BA 100 ")) + client.port.read_until(b"\r")
-        count = int(reply.decode().split()[2])
-        check(count > 0, f"the program counted while it ran: {reply!r}")
+        count = ascii_value(client, "AGGP 0, 2\r")
+        check(count > 0, f"the program counted while it ran: {count}")
         time.sleep(0.05)
         line(client, "AGGP 0, 2\r", f"BA 100 {count}\r", "nothing runs after STOP")
         # BIN, and a binary frame right behind it in the same write.

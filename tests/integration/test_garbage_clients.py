@@ -57,8 +57,11 @@ from motwin_harness import (  # noqa: E402
 )
 
 CHECKSUM_ERROR_REPLY = bytes.fromhex("02 01 01 00 00 00 00 00 04")
-TCP_RESYNC_PAUSE = 0.25  # longer than the server's TCP resync gap (100 ms, src/host/tcp_server.h)
+TCP_RESYNC_PAUSE = 0.5  # 5 x the server's TCP resync gap (100 ms, src/host/tcp_server.h): room for a stall
 SERIAL_RESYNC_GAP = 0.005  # a pause this long between two bytes drops a partial frame (core/tmcl/serial_link.h)
+# A pause meant to resync the serial link, once the server has read what came before (it counts
+# only silence it saw itself, src/host/event_loop.h): 10 x the gap, room for a descheduled server.
+PTY_RESYNC_PAUSE = 0.05
 ENTER_ASCII = 139
 
 
@@ -74,6 +77,9 @@ def random_bytes_client(port):
             c.send_raw(random_garbage(rng, 4096))
         data = c.read_available(0.5)
         check(data == b"", f"random bytes (no frame for module 1) got an answer: {data[:32].hex(' ')}")
+        # The pause counts from the last byte the server read (src/host/event_loop.h): a loaded
+        # server may still be reading the garbage long after it was sent.
+        c.wait_until_server_read_everything()
         time.sleep(TCP_RESYNC_PAUSE)
         expect_reply(c.request(GGP, 200, BANK_USER), GGP, STATUS_OK, what="good frame after random bytes and a pause")
     return "64 KiB of garbage, no reply, resynced by pause"
@@ -267,16 +273,21 @@ def test_pty_resync_by_pause(motwin):
                     ("2000 random bytes", random_garbage(rng, 2000) + b"\x01\x05"),
                 ]
                 for name, garbage in cases:
+                    read_before = server.bytes_read()
                     c.send_raw(garbage)
-                    time.sleep(0.05)  # > 5 ms
+                    server.wait_until_read(read_before + len(garbage))
+                    time.sleep(PTY_RESYNC_PAUSE)
                     c.expect_no_reply(0.05, f"{name}")
                     expect_reply(c.request(GAP, 43), GAP, STATUS_OK, 3210, f"GAP 43 after {name} and a pause")
                     c.expect_no_reply(0.05, f"after the reply ({name})")
                 # No pause: 7 bytes of a frame for module 1 run into the good frame; that costs one
                 # checksum-error reply (9 bytes), the rest is dropped by the next pause.
-                c.send_raw(frame(SAP, 43, 0, 9999)[:7] + frame(GAP, 43))
+                misaligned = frame(SAP, 43, 0, 9999)[:7] + frame(GAP, 43)
+                read_before = server.bytes_read()
+                c.send_raw(misaligned)
                 check_equal(c.read_exact(9), CHECKSUM_ERROR_REPLY, "misaligned frame")
-                time.sleep(0.05)
+                server.wait_until_read(read_before + len(misaligned))
+                time.sleep(PTY_RESYNC_PAUSE)
                 c.expect_no_reply(0.05, "after the misaligned frame")
                 expect_reply(c.request(GAP, 43), GAP, STATUS_OK, 3210, "GAP 43 after resync")
             server.stop()

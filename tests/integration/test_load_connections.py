@@ -90,7 +90,7 @@ def test_many_tcp_connections(motwin):
             memory.check("200 connections")
 
             # The server notices the closed sockets on its own schedule; then cycles.
-            time.sleep(0.5)
+            check_descriptors_return(server.proc.pid, descriptors_before, "after the 200 connections closed")
             for i in range(200):
                 with server.tcp() as c:
                     expect_reply(c.request(SGP, 10, BANK_USER, i), SGP, STATUS_OK, i, f"cycle {i}")

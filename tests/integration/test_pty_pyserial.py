@@ -51,9 +51,12 @@ def test_pty_reopen(motwin):
                     client.sap(43, 1000 + round_)
                     check_equal(client.gap(43), 1000 + round_, f"AP 43 in round {round_}")
                     # Leave a half frame behind: the next opener must not be confused by it
-                    # (it pauses longer than the resync gap).
+                    # (it pauses longer than the resync gap, 5 ms, from when the server read it:
+                    # the server counts only the silence it saw itself).
+                    read_before = server.bytes_read()
                     client.send_raw(frame(GAP, 43)[:4])
-                time.sleep(0.02)
+                    server.wait_until_read(read_before + 4)
+                time.sleep(0.05)
             with server.serial() as client:
                 expect_reply(client.request(GAP, 43), GAP, 100, 1002, "GAP 43 after reopening")
             server.stop()
@@ -69,9 +72,14 @@ def test_pty_reopen_after_unread_flood(motwin):
         with Server(motwin, os.path.join(tmp, "state"), tcp=False, pty_link=link) as server:
             flooder = serial.Serial(link, 115200, timeout=1)
             try:
-                flooder.write(frame(SGP, 20, 2, 5) * 3000)  # 27 000 bytes of replies nobody reads
+                flood = frame(SGP, 20, 2, 5) * 3000  # 27 000 bytes of replies nobody reads
+                read_before = server.bytes_read()
+                flooder.write(flood)
                 flooder.flush()
-                time.sleep(1.0)
+                # The server takes in no more requests than it has queue room for: once it has
+                # read the flood, at most its queue's worth (32) is left to answer.
+                server.wait_until_read(read_before + len(flood))
+                time.sleep(0.5)
             finally:
                 flooder.close()
             time.sleep(0.1)
