@@ -91,6 +91,22 @@ def collect(bus, duration, predicate=lambda msg: True):
             frames.append(msg)
 
 
+def collect_through(bus, predicate, last, linger=0.3, timeout=mh.FRAME_TIMEOUT):
+    """collect() for "exactly these frames": every frame matching predicate until one matching
+    `last` (the answer a test waits for, however late a loaded machine brings it) and `linger`
+    seconds after it (anything more that comes)."""
+    frames = []
+    deadline = time.monotonic() + timeout
+    while not frames or not last(frames[-1]):
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            raise TestFailure(f"timed out after {timeout} s; frames so far {frames!r}")
+        msg = bus.recv(remaining)
+        if msg is not None and predicate(msg):
+            frames.append(msg)
+    return frames + collect(bus, linger, predicate)
+
+
 class TmclCan:
     """TMCL over CAN on a python-can bus: requests on `receive_id`, replies on `send_id`."""
 
@@ -106,7 +122,7 @@ class TmclCan:
         self.bus.send(self.can.Message(arbitration_id=self.receive_id if can_id is None else can_id,
                                        data=bytes(data), is_extended_id=False))
 
-    def request_raw(self, data, timeout=1.0):
+    def request_raw(self, data, timeout=mh.FRAME_TIMEOUT):
         self.send_raw(data)
         return bytes(receive(self.bus, lambda m: m.arbitration_id == self.send_id, timeout,
                              f"TMCL reply on ID {self.send_id}").data)

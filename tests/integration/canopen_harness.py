@@ -5,18 +5,30 @@ Builds on motwin_harness (process handling, the serve contract, watchdog, run_te
 only declares its banner and endpoint lines. Raw frames on purpose: what is checked is the wire, not a library's view.
 """
 
+import itertools
 import socket
 import struct
 import time
 
 import motwin_harness as mh
-from motwin_harness import ServerError, TestFailure, check, check_equal  # noqa: F401 - re-exported
+from motwin_harness import FRAME_TIMEOUT, ServerError, TestFailure, check, check_equal  # noqa: F401 - re-exported
 
 NMT_START, NMT_STOP, NMT_PREOP, NMT_RESET_NODE, NMT_RESET_COMM = 0x01, 0x02, 0x80, 0x81, 0x82
 STATE_BOOTUP, STATE_STOPPED, STATE_OPERATIONAL, STATE_PREOP = 0x00, 0x04, 0x05, 0x7F
 SAVE = 0x65766173
 LOAD = 0x64616F6C
-SDO_TIMEOUT = 1.0
+# A liveness bound (an answer must come at all), generous for the ASan build on a loaded machine.
+SDO_TIMEOUT = 10.0
+# The simulation falls behind the wall clock when the machine is loaded (src/host/pacing.h):
+# waits for simulated progress fail only when simulated time stands still this long.
+SIM_STALL_LIMIT = 60.0
+# A frame a test sends to order events on the bus: no CANopen service uses this identifier.
+SEQUENCE_POINT_ID = 0x7FF
+_sequence_point_numbers = itertools.count()
+# Markers: SDO uploads of 1000 (device type, a variable) with a sub-index 1..255 that tells them
+# apart; each is answered at once with the abort 06090011 (no such sub-index), which echoes the
+# sub-index and is stamped with the bus time.
+_marker_numbers = itertools.count()
 
 
 def crc16_ccitt(data, crc=0):
@@ -56,11 +68,18 @@ class SdoAborted(TestFailure):
 
 
 class CanopenClient:
-    """python-can's socketcand Bus with CANopen master helpers speaking raw frames."""
+    """python-can's socketcand Bus with CANopen master helpers speaking raw frames.
+
+    Simulated time: socketcand frames carry the bus time (simulated seconds) as their stamp, and
+    the simulation runs slower than the wall clock on a loaded machine. What a test expects of
+    simulated time (a period, a ramp, a timeout of the node) it waits for in simulated time:
+    sim_now(), wait_sim(), poll_sim(), collect_sim(). python-can stamps SLCAN frames with wall
+    time: an SLCAN client measures simulated time with a socketcand client on the same bus."""
 
     def __init__(self, port, interface="socketcand"):
         import can  # Debian's python3-can
         self.can = can
+        self.stamps_simulated_time = interface == "socketcand"
         if interface == "slcan":
             # A pyserial URL; python-can sleeps 2 s after opening a serial port unless told not to.
             self.bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}", bitrate=1000000,
@@ -106,13 +125,184 @@ class CanopenClient:
     def drain(self, duration=0.05):
         self.collect(duration)
 
+    # Simulated time ---------------------------------------------------------------------------------
+    def frames_until_marker(self, node, predicate=lambda msg: True):
+        """Sends a marker to `node` and returns the frames matching predicate
+        that arrive before its answer: the node handles frames in the order the bus carries them
+        and answers an SDO request at once, so what it did for every frame sent before the marker
+        (a TPDO at a SYNC, say) is among them. The node must answer SDO (not stopped)."""
+        frames = []
+        self._marker(node, predicate, frames)
+        return frames
+
+    def _marker(self, node, predicate=None, frames=None):
+        """Sends a new marker to `node` and reads up to its answer (see _up_to_marker_answer)."""
+        sub = 1 + next(_marker_numbers) % 255
+        self.send(0x600 + node, [0x40, 0x00, 0x10, sub, 0, 0, 0, 0])
+        return self._up_to_marker_answer(node, sub, predicate, frames)
+
+    def _up_to_marker_answer(self, node, sub, predicate=None, frames=None):
+        """Reads up to the answer of `node` to marker `sub`; frames before it that match
+        `predicate` are appended to `frames` (bus order), other markers and their answers
+        excepted. Returns the answer."""
+        while True:
+            msg = self.receive(lambda m: True, SDO_TIMEOUT, f"SDO answer of node {node} to marker {sub}")
+            data = bytes(msg.data)
+            is_marker = len(data) == 8 and data[1:3] == b"\x00\x10" and data[3] != 0 and (
+                (msg.arbitration_id == 0x600 + node and data[0] == 0x40) or msg.arbitration_id == 0x580 + node)
+            if is_marker and msg.arbitration_id == 0x580 + node and data[3] == sub:
+                return msg
+            if not is_marker and predicate is not None and predicate(msg):
+                frames.append(msg)
+
+    def _follow_marker(self, node, answer, predicate=None, frames=None):
+        """Reads up to the answer to another client's marker (collect_sim with a clock)."""
+        return self._up_to_marker_answer(node, answer.data[3], predicate, frames)
+
+    def sim_now(self, node, others=()):
+        """The bus time (simulated seconds) now: the stamp of `node`'s answer to a marker. This
+        client and `others` (clients on the same bus, SLCAN ones too) drop what arrived before
+        it, so that they all go on from the same point of the bus."""
+        check(self.stamps_simulated_time, "simulated time needs a socketcand client")
+        answer = self._marker(node)
+        for other in others:
+            other._follow_marker(node, answer)
+        return answer.timestamp
+
+    def wait_sim(self, node, seconds):
+        """Waits until `seconds` of simulated time have passed (what time.sleep(seconds / speed)
+        means when the host keeps up). Frames that arrive meanwhile are dropped."""
+        if seconds > 0:
+            self.poll_sim(node, lambda: None, lambda _: False, seconds, "simulated time", fail=False)
+
+    def wait_sim_until(self, node, sim_time):
+        """Waits until the bus time is `sim_time` (simulated seconds since the server started, the
+        clock of --scenario files)."""
+        self.wait_sim(node, sim_time - self.sim_now(node))
+
+    def receive_sim(self, node, predicate, sim_timeout, what="frame"):
+        """receive() with a timeout in simulated time: the first frame matching predicate, which
+        must come within `sim_timeout` seconds of simulated time (marker stamps of `node`)."""
+        frames = []
+        start = last = self._marker(node, predicate, frames).timestamp
+        last_progress = time.monotonic()
+        while not frames:
+            time.sleep(0.005)
+            now = self._marker(node, predicate, frames).timestamp
+            if frames:
+                break
+            if now >= start + sim_timeout:
+                raise TestFailure(f"no {what} within {sim_timeout} s of simulated time")
+            if now > last:
+                last, last_progress = now, time.monotonic()
+            elif time.monotonic() - last_progress > SIM_STALL_LIMIT:
+                raise TestFailure(f"{what}: simulated time stood still at {now} s for {SIM_STALL_LIMIT} s")
+        return frames[0]
+
+    def wait_sim_seen_by(self, listener, seconds):
+        """wait_sim() for any NMT state (a stopped node answers no marker): this client sends
+        sequence points (SEQUENCE_POINT_ID) until `listener`, a socketcand client on the same bus,
+        sees one stamped `seconds` later than the first. The bus stamps a client's frame with the
+        simulated time it takes it in, after every frame this client sent before."""
+        check(listener.stamps_simulated_time, "simulated time needs a socketcand client")
+
+        def stamp_of_a_sequence_point():
+            number = next(_sequence_point_numbers) & 0xFFFF
+            point = bytes([2, number & 0xFF, number >> 8])
+            self.send(SEQUENCE_POINT_ID, point)
+            return listener.receive(lambda m: m.arbitration_id == SEQUENCE_POINT_ID and bytes(m.data) == point,
+                                    FRAME_TIMEOUT, "a sequence point").timestamp
+
+        start = last = stamp_of_a_sequence_point()
+        last_progress = time.monotonic()
+        while last < start + seconds:
+            time.sleep(0.005)
+            now = stamp_of_a_sequence_point()
+            if now > last:
+                last, last_progress = now, time.monotonic()
+            elif time.monotonic() - last_progress > SIM_STALL_LIMIT:
+                raise TestFailure(f"simulated time stood still at {now} s for {SIM_STALL_LIMIT} s")
+
+    def poll_sim(self, node, probe, done, sim_timeout, what, interval=0.005, fail=True):
+        """Calls probe() (SDO requests) until done(its value); returns that value. Fails when
+        `sim_timeout` seconds of simulated time (marker stamps of `node`) passed without it, or
+        the simulated time stood still for SIM_STALL_LIMIT seconds of wall time; with fail=False
+        returns None once the simulated time is up."""
+        start = last = self.sim_now(node)
+        last_progress = time.monotonic()
+        while True:
+            value = probe()
+            if done(value):
+                return value
+            now = self.sim_now(node)
+            if now >= start + sim_timeout:
+                if not fail:
+                    return None
+                raise TestFailure(f"{what}: not within {sim_timeout} s of simulated time (last {value!r})")
+            if now > last:
+                last, last_progress = now, time.monotonic()
+            elif time.monotonic() - last_progress > SIM_STALL_LIMIT:
+                raise TestFailure(f"{what}: simulated time stood still at {now} s for {SIM_STALL_LIMIT} s")
+            time.sleep(interval)
+
+    def collect_sim(self, node, duration, predicate=lambda msg: True, since=None, clock=None):
+        """collect() in simulated time: every frame matching predicate that the bus carries from
+        `since` (a sim_now(); default: now, the answer to a first marker) until `duration`
+        seconds later, as this client receives them. Markers to `node` (which must answer SDO:
+        pre-operational or operational) find the end of the window in bus order. `clock`: a
+        socketcand client on the same bus when this client's stamps are wall time (SLCAN): it
+        sees the same frames with their bus times, and this client's must be the same ones
+        (pass since=clock.sim_now(node, others=[this client]) to start elsewhere than now)."""
+        clock = clock or self
+        check(clock.stamps_simulated_time, "simulated time needs a socketcand client")
+        others = [self] if clock is not self else []
+        if since is None:
+            since = clock.sim_now(node, others)
+        mine, theirs = [], []
+        last, last_progress = since, time.monotonic()
+        while True:
+            answer = clock._marker(node, predicate, theirs)
+            now = answer.timestamp
+            for other in others:
+                other._follow_marker(node, answer, predicate, mine)
+            if now >= since + duration:
+                break
+            if now > last:
+                last, last_progress = now, time.monotonic()
+            elif time.monotonic() - last_progress > SIM_STALL_LIMIT:
+                raise TestFailure(f"collect_sim: simulated time stood still at {now} s for {SIM_STALL_LIMIT} s")
+            time.sleep(0.01)
+        inside = [m for m in theirs if m.timestamp <= since + duration]
+        if not others:
+            return inside
+        check_equal([(m.arbitration_id, bytes(m.data)) for m in mine],
+                    [(m.arbitration_id, bytes(m.data)) for m in theirs], "frames seen by both clients")
+        return mine[:len(inside)]
+
     # NMT ------------------------------------------------------------------------------------------
     def nmt(self, command, node):
         self.send(0x000, [command, node])
 
-    def wait_state(self, node, state, timeout=2.0):
+    def wait_state(self, node, state, timeout=FRAME_TIMEOUT):
         return self.receive(lambda m: m.arbitration_id == 0x700 + node and len(m.data) == 1 and m.data[0] == state,
                             timeout, f"state {state:#04x} from node {node}")
+
+    def wait_nmt(self, command, node):
+        """The next NMT `command` frame for `node` or for all (0) that another client sends."""
+        return self.receive(lambda m: m.arbitration_id == 0 and len(m.data) == 2 and m.data[0] == command and
+                            m.data[1] in (node, 0), FRAME_TIMEOUT, f"NMT {command:#04x}")
+
+    def state_after_nmt(self, node, command, state, within):
+        """The heartbeat of `node` with `state` that follows the NMT `command` another client sent
+        (to `node` or to all, 0), both as this socketcand client sees them; checks that it came
+        within `within` seconds of simulated time of the NMT frame: a state change sends its
+        heartbeat at once, not at the next period."""
+        check(self.stamps_simulated_time, "simulated time needs a socketcand client")
+        nmt = self.wait_nmt(command, node)
+        beat = self.wait_state(node, state)
+        delay = beat.timestamp - nmt.timestamp
+        check(delay <= within, f"heartbeat {state:#04x} {delay:.3f} s (simulated) after NMT {command:#04x}")
+        return beat
 
     # SDO ------------------------------------------------------------------------------------------
     def _request(self, node, data, timeout=SDO_TIMEOUT):
@@ -241,12 +431,42 @@ class CanopenClient:
         self.download(node, map_index, 0, len(entries), 1)
         self.download(node, comm_index, 1, cob_id, 4)
 
-    def lss(self, data, answer=True, timeout=1.0):
+    def lss(self, data, answer=True, timeout=SDO_TIMEOUT):
         """One LSS master frame (0x7E5, padded to 8 bytes); the slave's answer (0x7E4) or None."""
         self.send(0x7E5, list(data) + [0] * (8 - len(data)))
         if not answer:
             return None
         return bytes(self.receive(lambda m: m.arbitration_id == 0x7E4, timeout, f"LSS answer to {data[0]:#04x}").data)
+
+    def lss_answered(self, data, listener):
+        """Sends one LSS master frame and tells whether a slave answered it, with no time window
+        (fastscan asks questions that only the right slave answers). `listener`, a socketcand
+        client on the same bus, sees the frame between two sequence points (SEQUENCE_POINT_ID)
+        that this client sends just before and after it, and the answer if any between them: a
+        slave answers an LSS frame while it handles it, before the bus carries the next frame.
+        This client must get the answer too."""
+        number = next(_sequence_point_numbers) & 0xFFFF
+        self.send(SEQUENCE_POINT_ID, [0, number & 0xFF, number >> 8])
+        self.send(0x7E5, list(data) + [0] * (8 - len(data)))
+        self.send(SEQUENCE_POINT_ID, [1, number & 0xFF, number >> 8])
+
+        def sequence_point(end):
+            return lambda m: m.arbitration_id == SEQUENCE_POINT_ID and bytes(m.data) == bytes(
+                [end, number & 0xFF, number >> 8])
+
+        listener.receive(sequence_point(0), SDO_TIMEOUT, f"the frame before LSS {data[0]:#04x}")
+        after = sequence_point(1)
+        answers = []
+        while True:
+            msg = listener.receive(lambda m: m.arbitration_id == 0x7E4 or after(m), SDO_TIMEOUT,
+                                   f"the frame after LSS {data[0]:#04x}")
+            if after(msg):
+                break
+            answers.append(bytes(msg.data))
+        for answer in answers:
+            mine = bytes(self.receive(lambda m: m.arbitration_id == 0x7E4, SDO_TIMEOUT, "the LSS answer").data)
+            check_equal(mine, answer, f"LSS answer to {data[0]:#04x} as the listener saw it")
+        return bool(answers)
 
     def lss_silent(self, data, wait=0.2):
         """Sends an LSS frame that must not be answered; returns the answers seen (should be [])."""
@@ -295,7 +515,7 @@ class RawSocketcand:
         self.buffer += chunk
         return bool(chunk)
 
-    def read_element(self, timeout=2.0):
+    def read_element(self, timeout=FRAME_TIMEOUT):
         deadline = time.monotonic() + timeout
         while True:
             element = self._pop_element()
@@ -304,7 +524,7 @@ class RawSocketcand:
             if not self._receive_more(deadline, f"a socketcand element ({timeout} s)"):
                 raise TestFailure("socketcand server closed the connection")
 
-    def elements_until_closed(self, timeout=5.0):
+    def elements_until_closed(self, timeout=30.0):
         """Every element that arrives until the server closes the connection (a crash)."""
         elements = []
         deadline = time.monotonic() + timeout

@@ -43,7 +43,7 @@ def node_stats(line):
             for m in NODE_STATS.finditer(line)}
 
 
-def wait_for_stats(server, name, predicate, what, timeout=5.0):
+def wait_for_stats(server, name, predicate, what, timeout=60.0):
     """The first node part of a can-stats line (printed from now on) for which predicate holds."""
     seen = len(server.stdout_lines)
     deadline = time.monotonic() + timeout
@@ -67,12 +67,12 @@ def silent(bus, what, wait=0.4):
 
 def test_lss_activated_bit_rate_cuts_the_node_off_until_power_up(motwin):
     with TempDir() as tmp:
-        with serve(motwin, tmp, "1M") as server, server.bus() as bus:
+        with serve(motwin, tmp, "1M") as server, server.bus() as bus, server.bus() as listener:
             check_equal(bus.upload_u(NODE, 0x2707, 0), 1000, "2707 at start")
             bus.lss([0x04, 0x01], answer=False)  # switch state global: configuration
             check_equal(bus.lss([0x13, 0, 2])[:2], bytes([0x13, 0]), "configure bit timing 500 kbit/s")
-            bus.lss([0x15, 20, 0], answer=False)  # activate bit timing, switch delay 20 ms
-            time.sleep(0.2)
+            bus.lss([0x15, 20, 0], answer=False)  # activate bit timing, switch delay 20 ms: after 40 ms
+            bus.wait_sim_seen_by(listener, 0.2)
             silent(bus, "answers of a node switched to 500 kbit/s on a 1 Mbit/s bus")
             check_equal(bus.lss_silent([0x5E]), [], "LSS inquire node ID at 500 kbit/s")
             stats = wait_for_stats(server, "tmcm-3216", lambda s: s[1] and s[5] >= 3, "off-speed, 3 frames missed")
@@ -98,11 +98,11 @@ def test_stored_bit_rate_applies_at_reset_and_the_node_returns_on_a_bus_of_its_r
                         "boot-up and heartbeats at 500 kbit/s on a 1 Mbit/s bus")
             silent(bus, "answers after the reset")
             # Every heartbeat fails: TEC +8 each, error-passive from the 16th (1.6 s).
-            stats = wait_for_stats(server, "tmcm-3216", lambda s: s[2] == "error-passive", "error-passive", 6.0)
+            stats = wait_for_stats(server, "tmcm-3216", lambda s: s[2] == "error-passive", "error-passive")
             check(stats[1] and stats[4] >= 128 and stats[6] >= 16, f"counters of the cut-off node: {stats}")
             server.stop()
         with serve(motwin, tmp, "500k") as server, server.bus() as bus:
-            bus.wait_state(NODE, STATE_PREOP, timeout=1.0)  # its heartbeat reaches the bus
+            bus.wait_state(NODE, STATE_PREOP)  # its heartbeat reaches the bus
             check_equal(bus.upload_u(NODE, 0x2707, 0), 500, "2707 on a 500 kbit/s bus")
             bus.download(NODE, 0x2704, 0, 1000, 2)
             bus.download(NODE, 0x2706, 1, SAVE, 4)
@@ -112,7 +112,7 @@ def test_stored_bit_rate_applies_at_reset_and_the_node_returns_on_a_bus_of_its_r
             check_equal(bus.upload_u(NODE, 0x2707, 0), 1000, "2707 back on 1 Mbit/s")
             bus.nmt(NMT_RESET_NODE, NODE)
             bus.wait_state(NODE, 0x00)
-            time.sleep(0.3)
+            bus.wait_sim(NODE, 0.3)  # can-stats lines, every 0.1 s
             server.stop()
         lines = [line for line in server.stdout_lines if line.startswith("can-stats")]
         check(lines and not any(" node tmcm-3216 " in line for line in lines),

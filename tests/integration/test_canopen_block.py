@@ -14,8 +14,9 @@ import sys
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from can_bus_harness import collect_through  # noqa: E402
 from canopen_harness import CanServer, check_equal, crc16_ccitt, run_can_tests  # noqa: E402
-from motwin_harness import TempDir  # noqa: E402
+from motwin_harness import FRAME_TIMEOUT, TempDir  # noqa: E402
 
 NODE = 7
 
@@ -60,7 +61,8 @@ def test_protocol_switch_threshold(motwin):
     with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         # pst 21: 1008 (9 bytes) comes as a normal segmented upload.
         bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 127, 21, 0, 0])
-        msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "answer to a block upload with pst")
+        msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT,
+                          "answer to a block upload with pst")
         check_equal(bytes(msg.data), bytes([0x41, 0x08, 0x10, 0x00, 9, 0, 0, 0]), "segmented initiate response")
         bus.send(0x600 + NODE, [0x80, 0x08, 0x10, 0x00, 0, 0, 0, 0])  # client abort
         check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "segmented upload after the client's abort")
@@ -71,11 +73,11 @@ def test_client_gone_mid_block_transfer(motwin):
     with TempDir() as tmp, serve(motwin, tmp) as server:
         with server.bus() as bus:
             bus.send(0x600 + NODE, [0xC6, 0x17, 0x10, 0x00, 2, 0, 0, 0])
-            bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block download initiate response")
+            bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT, "block download initiate response")
         with server.bus() as bus:
             # Inside a sub-block every frame is a segment, so the stale transfer ends by the server's
             # 1 s timeout (abort 05040000), not by a new initiate.
-            aborts = bus.collect(1.5, lambda m: m.arbitration_id == 0x580 + NODE)
+            aborts = collect_through(bus.bus, lambda m: m.arbitration_id == 0x580 + NODE, lambda m: True, linger=0.5)
             check_equal([bytes(m.data) for m in aborts], [bytes([0x80, 0x17, 0x10, 0x00, 0x00, 0x00, 0x04, 0x05])],
                         "timeout abort of the abandoned block download")
             check_equal(bus.block_upload(NODE, 0x1008, 0), b"TMCM-3216", "block upload by a new client")

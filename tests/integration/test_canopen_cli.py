@@ -14,11 +14,13 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    STATE_BOOTUP, STATE_OPERATIONAL, STATE_PREOP, STATE_STOPPED, CanServer, check, check_equal,
+    NMT_PREOP, NMT_START, NMT_STOP, STATE_BOOTUP, STATE_OPERATIONAL, STATE_PREOP, STATE_STOPPED, CanServer, check,
+    check_equal,
 )
 from motwin_harness import TempDir, run_tests  # noqa: E402
 
 NODE = 12
+NMT_COMMANDS = {"start": NMT_START, "stop": NMT_STOP, "preop": NMT_PREOP}
 
 
 def motwin_run(motwin, *args):
@@ -57,7 +59,7 @@ def test_sdo_and_nmt_commands(motwin):
         with server.bus() as bus:
             bus.drain(0.1)
             ok("nmt", can, "start", str(NODE))
-            bus.wait_state(NODE, STATE_OPERATIONAL, timeout=1.0)
+            bus.wait_state(NODE, STATE_OPERATIONAL)
         server.stop()
 
 
@@ -78,22 +80,24 @@ def test_nmt_commands_change_the_state(motwin):
             for command, state in (("start", STATE_OPERATIONAL), ("stop", STATE_STOPPED), ("preop", STATE_PREOP),
                                    ("start", STATE_OPERATIONAL)):
                 check_equal(ok("nmt", can, command, str(NODE)), "", f"nmt {command}: output")
-                msg = bus.wait_state(NODE, state, timeout=0.8)
+                # Within 0.8 s of simulated time of the NMT frame (the period is 1 s).
+                msg = bus.state_after_nmt(NODE, NMT_COMMANDS[command], state, within=0.8)
                 check_equal(bytes(msg.data), bytes([state]), f"heartbeat after nmt {command}")
                 if command == "stop":
                     status, _, _ = motwin_run(motwin, "sdo", "read", can, str(NODE), "1000", "0")
                     check_equal(status, 2, "SDO while stopped: no answer")
             ok("nmt", can, "reset", str(NODE))
-            bus.wait_state(NODE, STATE_BOOTUP, timeout=1.0)
+            bus.wait_state(NODE, STATE_BOOTUP)
             check_equal(ok("sdo", "read", can, str(NODE), "1017", "0", "u16"), "0", "1017 back to its default")
             ok("nmt", can, "start", "0")  # broadcast
-            frames = bus.collect(0.3, lambda m: m.arbitration_id in (0x180 + NODE, 0x700 + NODE))
+            since = bus.wait_nmt(NMT_START, 0).timestamp  # 0.3 s of simulated time from the NMT frame on
+            frames = bus.collect_sim(NODE, 0.3, lambda m: m.arbitration_id in (0x180 + NODE, 0x700 + NODE), since=since)
             check_equal([(m.arbitration_id, bytes(m.data)) for m in frames], [(0x180 + NODE, bytes([0x40, 0x02]))],
                         "TPDO 1 on entering operational (statusword), no heartbeat (1017 = 0)")
             ok("sdo", "write", can, str(NODE), "1017", "0", "u16", "1000")
-            bus.wait_state(NODE, STATE_OPERATIONAL, timeout=1.0)
+            bus.wait_state(NODE, STATE_OPERATIONAL)
             ok("nmt", can, "reset-comm", "0")
-            bus.wait_state(NODE, STATE_BOOTUP, timeout=1.0)
+            bus.wait_state(NODE, STATE_BOOTUP)
             check_equal(ok("sdo", "read", can, str(NODE), "1017", "0", "u16"), "0", "1017 after reset communication")
             bus.drain(0.1)
             for bad in (["bogus", str(NODE)], ["start", "128"]):

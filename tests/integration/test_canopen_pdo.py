@@ -16,7 +16,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from canopen_harness import (  # noqa: E402
     NMT_PREOP, NMT_START, SAVE, CanServer, check, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir  # noqa: E402
+from motwin_harness import FRAME_TIMEOUT, TempDir  # noqa: E402
 
 NODE = 9
 DUMMY_U8, DUMMY_U16, DUMMY_U32 = 0x00050008, 0x00060010, 0x00070020
@@ -35,7 +35,9 @@ def test_default_pdos_of_axis_0(motwin):
     # entering operational; TPDO 3/4 are synchronous; the PDOs of axes 1 and 2 start disabled.
     with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.nmt(NMT_START, NODE)
-        frames = bus.collect(0.3, lambda m: 0x180 <= m.arbitration_id < 0x580)
+        is_pdo = lambda m: 0x180 <= m.arbitration_id < 0x580  # noqa: E731
+        first = bus.receive(is_pdo, FRAME_TIMEOUT, "a TPDO on entering operational")
+        frames = [first] + bus.collect_sim(NODE, 0.3, is_pdo, since=first.timestamp)
         check_equal([(m.arbitration_id, bytes(m.data)) for m in frames],
                     [(0x180 + NODE, bytes([0x40, 0x02])), (0x280 + NODE, bytes([0x40, 0x02, 0x00]))],
                     "TPDO 1 and 2 of axis 0 (switch on disabled, mode 0)")
@@ -51,15 +53,17 @@ def test_reconfiguration_in_python_canopen_order_and_event_timer(motwin):
         check_equal(bus.upload_u(NODE, 0x1800, 5), 100, "1800 sub 5 event timer")
         check_equal(bus.collect(0.2, lambda m: m.arbitration_id == cob_id), [], "TPDO in pre-operational")
         bus.nmt(NMT_START, NODE)
-        frames = pdo_frames(bus.collect(0.75), cob_id)
-        check(6 <= len(frames) <= 9, f"{len(frames)} TPDOs in 0.75 s with a 100 ms event timer")
+        # 0.75 s of simulated time from the first TPDO on, which goes out with the NMT command.
+        first = bus.receive(lambda m: m.arbitration_id == cob_id, FRAME_TIMEOUT, "the first TPDO")
+        frames = [first] + pdo_frames(bus.collect_sim(NODE, 0.75, since=first.timestamp), cob_id)
+        check(6 <= len(frames) <= 9, f"{len(frames)} TPDOs in 0.75 s (simulated) with a 100 ms event timer")
         check_equal(bytes(frames[0].data), bytes(6), "TPDO data (6 dummy bytes)")
         gaps = [round((b.timestamp - a.timestamp) * 1000) for a, b in zip(frames, frames[1:])]
         # The first one goes out when the NMT frame arrives, between two 1 ms service ticks.
         check(99 <= gaps[0] <= 100 and all(gap == 100 for gap in gaps[1:]),
               f"TPDO gaps in ms of simulated time: {gaps}")
         bus.nmt(NMT_PREOP, NODE)
-        bus.drain(0.05)
+        bus.frames_until_marker(NODE)  # what was sent before the NMT command took effect
         check_equal(bus.collect(0.3, lambda m: m.arbitration_id == cob_id), [], "TPDOs in pre-operational")
         server.stop()
 
@@ -87,14 +91,14 @@ def test_rpdo_length_errors_send_emcy(motwin):
         bus.drain(0.05)
         emcy = 0x80 + NODE
         bus.send(0x200 + NODE, [1, 2])
-        msg = bus.receive(lambda m: m.arbitration_id == emcy, 1.0, "EMCY 8210")
+        msg = bus.receive(lambda m: m.arbitration_id == emcy, FRAME_TIMEOUT, "EMCY 8210")
         check_equal(bytes(msg.data), bytes([0x10, 0x82, 0x11, 0x00, 0xFF, 0, 0, 0]), "EMCY 8210 (PDO too short)")
         check_equal(bus.upload_u(NODE, 0x1001, 0), 0x11, "1001 during the error")
         bus.send(0x200 + NODE, [1, 2, 3])
-        msg = bus.receive(lambda m: m.arbitration_id == emcy, 1.0, "EMCY 0000")
+        msg = bus.receive(lambda m: m.arbitration_id == emcy, FRAME_TIMEOUT, "EMCY 0000")
         check_equal(bytes(msg.data), bytes([0, 0, 0, 0, 0xFF, 0, 0, 0]), "EMCY 0000 (error reset)")
         bus.send(0x200 + NODE, [1, 2, 3, 4, 5])
-        msg = bus.receive(lambda m: m.arbitration_id == emcy, 1.0, "EMCY 8220")
+        msg = bus.receive(lambda m: m.arbitration_id == emcy, FRAME_TIMEOUT, "EMCY 8220")
         check_equal(bytes(msg.data[:3]), bytes([0x20, 0x82, 0x11]), "EMCY 8220 (PDO too long)")
         server.stop()
 
@@ -110,8 +114,9 @@ def test_pdo_configuration_survives_store_and_restart(motwin):
             check_equal(bus.upload_u(NODE, 0x1A01, 0), 1, "1A01 sub 0 after restart")
             check_equal(bus.upload_u(NODE, 0x1A01, 1), DUMMY_U8, "1A01 sub 1 after restart")
             bus.nmt(NMT_START, NODE)
-            frames = pdo_frames(bus.collect(0.4), 0x280 + NODE)
-            check(len(frames) >= 5, f"{len(frames)} TPDOs in 0.4 s at 50 ms after the restart")
+            first = bus.receive(lambda m: m.arbitration_id == 0x280 + NODE, FRAME_TIMEOUT, "the first TPDO 2")
+            frames = [first] + pdo_frames(bus.collect_sim(NODE, 0.4, since=first.timestamp), 0x280 + NODE)
+            check(len(frames) >= 5, f"{len(frames)} TPDOs in 0.4 s (simulated) at 50 ms after the restart")
             check_equal(bytes(frames[0].data), b"\0", "TPDO 2 data")
             server.stop()
 

@@ -20,7 +20,7 @@ from canopen_harness import (  # noqa: E402
     LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
     STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, check, check_equal, run_can_tests,
 )
-from motwin_harness import TempDir  # noqa: E402
+from motwin_harness import FRAME_TIMEOUT, TempDir  # noqa: E402
 
 NODE = 5
 
@@ -61,8 +61,8 @@ def test_heartbeat_at_the_1017_period(motwin):
     with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         bus.download(NODE, 0x1017, 0, 100, 2)
         check_equal(bus.upload_u(NODE, 0x1017, 0), 100, "1017 read back")
-        beats = bus.collect(1.2, lambda m: m.arbitration_id == 0x700 + NODE)
-        check(10 <= len(beats) <= 14, f"{len(beats)} heartbeats in 1.2 s at 100 ms")
+        beats = bus.collect_sim(NODE, 1.2, lambda m: m.arbitration_id == 0x700 + NODE)
+        check(10 <= len(beats) <= 14, f"{len(beats)} heartbeats in 1.2 s (simulated) at 100 ms")
         for msg in beats:
             check_equal(bytes(msg.data), bytes([STATE_PREOP]), "heartbeat state")
         # Stamped with simulated time: exactly one period apart (1 ms tick resolution).
@@ -86,7 +86,7 @@ def test_abort_codes(motwin):
         check_equal(bus.abort_code(bus.download, NODE, 0x1010, 1, 0x12345678, 4), 0x08000020, "bad signature")
         # Block upload request with block size 0: aborted with 05040002 (test_canopen_block.py does the rest).
         bus.send(0x600 + NODE, [0xA4, 0x08, 0x10, 0x00, 0x00, 0, 0, 0])
-        msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "block upload answer")
+        msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT, "block upload answer")
         check_equal(bytes(msg.data), bytes([0x80, 0x08, 0x10, 0x00, 0x02, 0x00, 0x04, 0x05]), "block upload abort")
         # Still serving.
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "1000 after the aborts")
@@ -98,15 +98,15 @@ def test_nmt_start_stop_preop(motwin):
         bus.download(NODE, 0x1017, 0, 50, 2)
         bus.wait_state(NODE, STATE_PREOP)
         bus.nmt(NMT_START, NODE)
-        bus.wait_state(NODE, STATE_OPERATIONAL, timeout=0.5)
+        bus.wait_state(NODE, STATE_OPERATIONAL)
         bus.nmt(NMT_STOP, 0)
-        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)
+        bus.wait_state(NODE, STATE_STOPPED)
         bus.send(0x600 + NODE, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
         answers = bus.collect(0.3, lambda m: m.arbitration_id == 0x580 + NODE)
         check_equal(answers, [], "SDO answers while stopped")
-        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)  # the heartbeat goes on
+        bus.wait_state(NODE, STATE_STOPPED)  # the heartbeat goes on
         bus.nmt(NMT_PREOP, NODE)
-        bus.wait_state(NODE, STATE_PREOP, timeout=0.5)
+        bus.wait_state(NODE, STATE_PREOP)
         check_equal(bus.upload_u(NODE, 0x1000, 0), 0xFFFF0192, "SDO in pre-operational again")
         server.stop()
 
@@ -151,15 +151,15 @@ def test_clients_see_each_other_but_not_themselves(motwin):
         a.drain(0.1)
         b.drain(0.1)
         a.send(0x123, [1, 2, 3])
-        msg = b.receive(lambda m: m.arbitration_id == 0x123, 1.0, "A's frame at B")
+        msg = b.receive(lambda m: m.arbitration_id == 0x123, FRAME_TIMEOUT, "A's frame at B")
         check_equal(bytes(msg.data), b"\x01\x02\x03", "data")
         b.send(0x80, [])  # an empty frame (python-can sends "< send 80 0  >")
-        msg = a.receive(lambda m: m.arbitration_id == 0x80, 1.0, "B's empty frame at A")
+        msg = a.receive(lambda m: m.arbitration_id == 0x80, FRAME_TIMEOUT, "B's empty frame at A")
         check_equal(len(msg.data), 0, "empty frame length")
         check_equal(a.collect(0.3, lambda m: m.arbitration_id == 0x123), [], "A's own frame echoed to A")
         # Both see the node's answer to A's request.
         a.send(0x600 + NODE, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
-        b.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "SDO answer seen by B")
+        b.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT, "SDO answer seen by B")
         server.stop()
 
 
@@ -200,7 +200,7 @@ def test_client_disconnect_mid_transfer(motwin):
     with TempDir() as tmp, serve(motwin, tmp) as server:
         with server.bus() as bus:
             bus.send(0x600 + NODE, [0x40, 0x08, 0x10, 0, 0, 0, 0, 0])  # segmented upload started
-            bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, "initiate response")
+            bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT, "initiate response")
         with server.bus() as bus:
             # The old transfer times out (05040000 after 1 s) or is replaced by this one.
             check_equal(bus.upload(NODE, 0x1008, 0), b"TMCM-3216", "a new transfer")
@@ -215,7 +215,8 @@ def test_malformed_sdo_frames_on_the_wire(motwin):
     with TempDir() as tmp, serve(motwin, tmp) as server, server.bus() as bus:
         def exchange(data):
             bus.send(0x600 + NODE, data)
-            msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, 1.0, f"answer to {bytes(data).hex()}")
+            msg = bus.receive(lambda m: m.arbitration_id == 0x580 + NODE, FRAME_TIMEOUT,
+                              f"answer to {bytes(data).hex()}")
             return bytes(msg.data)
 
         check_equal(exchange([0x40, 0x00, 0x10, 0x00]), bytes([0x80, 0, 0, 0, 0x01, 0x00, 0x04, 0x05]),
@@ -240,17 +241,17 @@ def test_heartbeat_consumer_emcy(motwin):
         bus.download(NODE, 0x1016, 1, (0x10 << 16) | 200, 4)  # producer 0x10, 200 ms
         bus.download(NODE, 0x1017, 0, 50, 2)
         bus.nmt(NMT_START, NODE)
-        bus.wait_state(NODE, STATE_OPERATIONAL, timeout=0.5)
+        bus.wait_state(NODE, STATE_OPERATIONAL)
         for _ in range(3):
             bus.send(0x710, [0x05])
             bus.drain(0.05)
-        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 1.0, "EMCY after the heartbeats stop")
+        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, FRAME_TIMEOUT, "EMCY after the heartbeats stop")
         check_equal(bytes(emcy.data), bytes([0x30, 0x81, 0x11, 0x00, 0xFF, 0x00, 0x00, 0x00]), "EMCY 8130")
-        bus.wait_state(NODE, STATE_STOPPED, timeout=0.5)
+        bus.wait_state(NODE, STATE_STOPPED)
         bus.send(0x710, [0x05])  # back: EMCY 0000 waits while stopped (no EMCY in stopped)...
         check_equal(bus.collect(0.2, lambda m: m.arbitration_id == 0x80 + NODE), [], "EMCY while stopped")
         bus.nmt(NMT_PREOP, NODE)  # ...and goes out in pre-operational
-        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, 1.0, "EMCY 0000 in pre-operational")
+        emcy = bus.receive(lambda m: m.arbitration_id == 0x80 + NODE, FRAME_TIMEOUT, "EMCY 0000 in pre-operational")
         check_equal(bytes(emcy.data), bytes([0, 0, 0, 0, 0xFF, 0, 0, 0]), "EMCY 0000")
         # Another heartbeat first: the 200 ms since the last one may have run out again by now
         # (slow builds), which would set 1001 once more.

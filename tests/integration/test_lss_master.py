@@ -10,7 +10,6 @@ import os
 import re
 import subprocess
 import sys
-import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -20,6 +19,11 @@ from canopen_harness import CanopenClient  # noqa: E402
 from motwin_harness import TempDir, run_tests  # noqa: E402
 
 VENDOR, PRODUCT, REVISION = 0x286, 3216, 0x00010004
+# `motwin lss` waits this long for an answer that must come (a liveness bound: the wait ends with
+# the answer), and a fastscan step this long for an answer that may not come (silence says "no",
+# so a late answer on a loaded machine would mislead the scan; the default is 0.05 s).
+ANSWER_TIMEOUT = "10"
+FASTSCAN_STEP_TIMEOUT = "0.5"
 
 
 def lss(motwin, server, *args):
@@ -29,7 +33,7 @@ def lss(motwin, server, *args):
 
 
 def lss_ok(motwin, server, *args):
-    status, out, err = lss(motwin, server, *args)
+    status, out, err = lss(motwin, server, "--timeout", ANSWER_TIMEOUT, *args)
     check_equal(status, 0, f"motwin lss {' '.join(args)} (stderr {err!r})")
     return out
 
@@ -109,11 +113,14 @@ def test_fastscan_finds_unconfigured_modules(motwin):
             client = CanopenClient(server.port())
             try:
                 client.nmt(0x81, 0)
-                time.sleep(0.2)
-                check_equal(lss_ok(motwin, server, "fastscan", "--node-id", "20", "--store"),
+                # Reset: an unconfigured slave answers a fastscan reset (the master's first question).
+                client.lss([0x51, 0, 0, 0, 0, 0x80, 0, 0])
+                check_equal(lss_ok(motwin, server, "fastscan", "--step-timeout", FASTSCAN_STEP_TIMEOUT,
+                                   "--node-id", "20", "--store"),
                             f"vendor 0x{VENDOR:08X} product 0x{PRODUCT:08X} revision 0x{REVISION:08X} serial 0x00000003",
                             "the lower identity first")
-                check_equal(lss_ok(motwin, server, "fastscan", "--node-id", "21"),
+                check_equal(lss_ok(motwin, server, "fastscan", "--step-timeout", FASTSCAN_STEP_TIMEOUT,
+                                   "--node-id", "21"),
                             f"vendor 0x{VENDOR:08X} product 0x{PRODUCT:08X} revision 0x{REVISION:08X} serial 0x00000007",
                             "then the other")
                 check_equal(lss(motwin, server, "fastscan")[0], 1, "nobody left unconfigured")
@@ -140,10 +147,9 @@ def test_activate_bitrate(motwin):
                 check_equal(status, 2, f"a switch delay above 65535 ms ({err})")
                 check_equal(lss_ok(motwin, server, "activate-bitrate", "100"), "", "activate-bitrate output")
                 lss_ok(motwin, server, "switch-global", "waiting")
-                # Active after twice the delay (200 ms of simulated time); a loaded machine may lag.
-                deadline = time.monotonic() + 3.0
-                while client.upload_u(5, 0x2707, 0) != 250 and time.monotonic() < deadline:
-                    time.sleep(0.05)
+                # Active after twice the delay (200 ms of simulated time).
+                client.poll_sim(5, lambda: client.upload_u(5, 0x2707, 0), lambda rate: rate == 250, 3.0,
+                                "2707 = 250 after the activation", interval=0.05)
                 check_equal(client.upload_u(5, 0x2707, 0), 250, "2707 after the activation")
                 check_equal(client.upload_u(5, 0x2704, 0), 1000, "2704: an activated rate is not stored")
             finally:

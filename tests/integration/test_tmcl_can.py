@@ -14,7 +14,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from can_bus_harness import BusServer, TmclCan, check, check_equal, collect, open_bus, receive  # noqa: E402
-from motwin_harness import TcpClient, TempDir, run_tests  # noqa: E402
+from motwin_harness import FRAME_TIMEOUT, TcpClient, TempDir, run_tests  # noqa: E402
 
 
 def serve(motwin, tmp, *extra):
@@ -71,7 +71,7 @@ def test_can_ids_take_effect_at_once_and_are_stored(motwin):
             try:
                 tmcl = TmclCan(bus)
                 tmcl.send_raw([9, 70, 0, 0, 0, 0, 0x55])
-                msg = receive(bus, lambda m: m.arbitration_id in (2, 0x55), 1.0, "reply to SGP 70")
+                msg = receive(bus, lambda m: m.arbitration_id in (2, 0x55), FRAME_TIMEOUT, "reply to SGP 70")
                 check_equal(msg.arbitration_id, 0x55, "the reply to SGP 70 uses the new send ID")
                 check_equal(bytes(msg.data), bytes([1, 100, 9, 0, 0, 0, 0x55]), "reply to SGP 70")
                 tmcl.send_id = 0x55
@@ -143,9 +143,11 @@ def test_slcan_tcp_and_pty(motwin):
                 # The pty client also sees the TCP client's request and its reply: one bus.
                 collect(over_pty, 0.2)
                 TmclCan(over_tcp).send_raw([10, 71, 0, 0, 0, 0, 0])
-                msg = receive(over_pty, lambda m: m.arbitration_id == 1, 1.0, "the TCP client's request on the pty")
+                msg = receive(over_pty, lambda m: m.arbitration_id == 1, FRAME_TIMEOUT,
+                              "the TCP client's request on the pty")
                 check_equal(bytes(msg.data), bytes([10, 71, 0, 0, 0, 0, 0]), "request seen on the pty")
-                reply = receive(over_pty, lambda m: m.arbitration_id == 2, 1.0, "the module's reply on the pty")
+                reply = receive(over_pty, lambda m: m.arbitration_id == 2, FRAME_TIMEOUT,
+                                "the module's reply on the pty")
                 check_equal(bytes(reply.data), bytes([1, 100, 10, 0, 0, 0, 1]), "reply seen on the pty")
             finally:
                 over_tcp.shutdown()

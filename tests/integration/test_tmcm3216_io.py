@@ -7,7 +7,6 @@ once the power stage is off; driver temperature reaches 2102.
 
 import os
 import sys
-import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -33,10 +32,10 @@ def test_inputs_outputs_and_switches(motwin):
             check_equal(bus.upload_u(NODE, 0x68FD, 0), (1 << 18) | 4, "60FD of motor 1: home switch, DIO2")
             # 2005 bit 0 disables the left limit switch of motor 0, bit 2 inverts it.
             bus.download(NODE, 0x2005, 0, 1, 4)
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x60FD, 0), 1 << 18, "60FD with the left switch disabled")
             bus.download(NODE, 0x2005, 0, 4, 4)
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x60FD, 0), 1 << 18, "60FD with the left switch inverted")
             # DIO0 as a push-pull output, switched through the mask.
             check_equal(bus.abort_code(bus.download, NODE, 0x2711, 0, 0x10, 2), ABORT_INVALID_VALUE, "2711 bit 4")
@@ -46,7 +45,7 @@ def test_inputs_outputs_and_switches(motwin):
             bus.download(NODE, 0x2703, 2, 0xF << 16, 4)
             bus.download(NODE, 0x2703, 1, 1 << 16, 4)
             check_equal(bus.upload_u(NODE, 0x2703, 1), 1 << 16, "2703 sub 1 through the mask")
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x2702, 0), (1 << 18) | (1 << 16), "2702 reads the output back")
             server.stop()
         outputs = [line for line in server.stdout_lines if line.startswith("output ")]
@@ -66,7 +65,7 @@ def test_stepper_objects_and_states(motwin):
             bus.download(NODE, 0x2405, 0, 3, 4)  # no limit switches on motor 2
             for cw in (6, 7, 15):
                 bus.download(NODE, 0x7040, 0, cw, 2)
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x7041, 0) & 0x6F, 0x27, "motor 2 operation enabled")
             check_equal(bus.abort_code(bus.download, NODE, 0x2405, 0, 0, 4), ABORT_DEVICE_STATE,
                         "2005 outside SWITCH ON DISABLED")
@@ -74,10 +73,10 @@ def test_stepper_objects_and_states(motwin):
                         "200B outside SWITCH ON DISABLED")
             bus.download(NODE, 0x2403, 0, 200, 1)  # currents may change any time
             bus.download(NODE, 0x2400, 0, 4, 1)
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x2507, 0), 8, "2107 while the power stage is on")
             bus.download(NODE, 0x7040, 0, 0, 2)  # disable voltage: SWITCH ON DISABLED
-            time.sleep(0.05)
+            bus.wait_sim(NODE, 0.05)
             check_equal(bus.upload_u(NODE, 0x2507, 0), 4, "2107 after the power stage went off")
             bus.download(NODE, 0x2405, 0, 0, 4)
             check_equal(bus.upload_u(NODE, 0x2405, 0), 0, "2005 written in SWITCH ON DISABLED")
