@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -98,13 +101,61 @@ TEST_F(PtyEndpointTest, clients_may_open_and_close_the_device_repeatedly) {
   EXPECT_EQ(exchange(last, request(kGap, 43, 0, 0)), reply(100, kGap, 1004));
 }
 
+// A pty passes a client's bytes on to the master asynchronously (a kernel worker), and the loop
+// sees a pause of the line only where one of its polls found the master quiet. On a loaded
+// machine the bytes may reach the master well after the client wrote them, so the tests below
+// wait for the kernel and for the endpoint's reads, not for the wall clock.
+
+// Bytes this process has read so far (rchar of /proc/self/io), less its reads of that file: the
+// endpoint's reads of the pty master while the client only writes.
+uint64_t bytes_read_by_this_process() {
+  static uint64_t read_from_proc_self_io = 0;  // rchar counts these reads too
+  char text[4096];
+  const int fd = ::open("/proc/self/io", O_RDONLY | O_CLOEXEC);
+  const ssize_t n = fd < 0 ? -1 : ::read(fd, text, sizeof(text) - 1);
+  if (fd >= 0) ::close(fd);
+  if (n <= 0) {
+    ADD_FAILURE() << "cannot read /proc/self/io";
+    return 0;
+  }
+  text[n] = '\0';
+  const char* rchar = std::strstr(text, "rchar:");
+  EXPECT_NE(rchar, nullptr) << text;
+  // The text shows rchar as it was before this read.
+  const uint64_t value = rchar == nullptr ? 0 : std::strtoull(rchar + 6, nullptr, 10) - read_from_proc_self_io;
+  read_from_proc_self_io += static_cast<uint64_t>(n);
+  return value;
+}
+
+// Bytes waiting at the pty master for the endpoint to read: the master is the one descriptor of
+// this process that is open on /dev/ptmx.
+int bytes_waiting_at_the_master() {
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code error;
+    if (std::filesystem::read_symlink(entry.path(), error) != "/dev/ptmx") continue;
+    int waiting = 0;
+    EXPECT_EQ(::ioctl(std::stoi(entry.path().filename().string()), FIONREAD, &waiting), 0);
+    return waiting;
+  }
+  ADD_FAILURE() << "no descriptor on /dev/ptmx";
+  return 0;
+}
+
 TEST_F(PtyEndpointTest, a_pause_resynchronises_after_a_half_frame) {
   open_endpoint();
   SerialTestClient client(link());
+  const uint64_t read_before = bytes_read_by_this_process();
   client.send(slice(request(kGap, 43, 0, 0), 0, 4));
-  // Longer than the 5 ms resync gap, measured by the loop's clock.
+  ASSERT_TRUE(
+      testing::pump_until([this] { rig_.step(); }, [&] { return bytes_read_by_this_process() >= read_before + 4; }));
+  // Longer than the 5 ms resync gap, measured by the loop's clock from when it read the half:
+  // until a loop iteration (its poll) starts 20 ms later.
   const uint64_t start = monotonic_now_us();
-  while (monotonic_now_us() - start < 20'000) rig_.step();
+  uint64_t step_start = start;
+  while (step_start - start < 20'000) {
+    step_start = monotonic_now_us();
+    rig_.step();
+  }
   EXPECT_EQ(exchange(client, request(kGap, 43, 0, 0)), reply(100, kGap, 4000));
 }
 
@@ -112,11 +163,15 @@ TEST_F(PtyEndpointTest, a_stall_of_the_server_is_no_pause_of_the_line) {
   open_endpoint();
   SerialTestClient client(link());
   const Bytes frame = request(kGap, 43, 0, 0);
+  const uint64_t read_before = bytes_read_by_this_process();
   client.send(slice(frame, 0, 4));
-  for (int i = 0; i < 20; ++i) rig_.step();  // the first half is read
+  // The first half is read, and the loop stops right after (it sees no quiet line after it).
+  ASSERT_TRUE(
+      testing::pump_until([this] { rig_.step(); }, [&] { return bytes_read_by_this_process() >= read_before + 4; }));
   // The rest follows at once, but the server does not run for 20 ms (a loaded machine): the
   // bytes wait in the pty, and the line itself never paused.
   client.send(slice(frame, 4, 9));
+  ASSERT_TRUE(testing::pump_until([] { ::usleep(100); }, [] { return bytes_waiting_at_the_master() >= 5; }));
   ::usleep(20'000);
   EXPECT_EQ(exchange(client, {}), reply(100, kGap, 4000));
 }
