@@ -1,5 +1,6 @@
 #include "tools/lss_client.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace motwin::tools {
@@ -15,7 +16,8 @@ constexpr uint8_t kSwitchSelectiveAnswer = 0x44;
 constexpr uint8_t kIdentifySlave = 0x4F;
 constexpr uint8_t kFastscan = 0x51;
 constexpr uint8_t kFastscanReset = 0x80;
-// Quiet time that ends the draining of stale answers before a request.
+// Quiet time that ends the draining of stale answers before a request. Fastscan drains longer:
+// a tenth of its step timeout, which a user raises on a slow or loaded host (--step-timeout).
 constexpr int kSettleMs = 2;
 
 int64_t now_ms() {
@@ -43,10 +45,11 @@ LssResult sent_only(const Result<void>& sent) {
 
 }  // namespace
 
-Result<void> LssMaster::send(const std::array<uint8_t, 8>& data) {
+Result<void> LssMaster::send(const std::array<uint8_t, 8>& data, int settle_ms) {
   // Answers that arrived late (several slaves answer one fastscan probe, or a configure) must
-  // not pass for answers to this request.
-  while (bus_.receive(kSettleMs)) {
+  // not pass for answers to this request. Over TCP each answer is a write of its own, so on a
+  // loaded host the server may be held up between the answers of two slaves.
+  while (bus_.receive(settle_ms)) {
   }
   return bus_.send(can::make_frame(kLssMasterId, data.data(), 8));
 }
@@ -141,14 +144,15 @@ LssResult LssMaster::inquire(uint8_t command) {
 }
 
 Result<LssIdentityNumbers> LssMaster::fastscan(int step_timeout_ms) {
-  const auto probe = [this, step_timeout_ms](uint32_t id_number, uint8_t bit_checked, uint8_t sub, uint8_t next,
-                                             int timeout_ms) {
+  const int settle_ms = std::max(kSettleMs, step_timeout_ms / 10);
+  const auto probe = [this, step_timeout_ms, settle_ms](uint32_t id_number, uint8_t bit_checked, uint8_t sub,
+                                                        uint8_t next, int timeout_ms) {
     std::array<uint8_t, 8> data{kFastscan};
     put_u32(data, 1, id_number);
     data[5] = bit_checked;
     data[6] = sub;
     data[7] = next;
-    if (!send(data)) return false;
+    if (!send(data, settle_ms)) return false;
     return await(kIdentifySlave, timeout_ms > 0 ? timeout_ms : step_timeout_ms).has_value();
   };
   // Reset: every unconfigured slave in waiting state answers. The first probe may wait behind a

@@ -51,14 +51,16 @@ class LssMaster {
 
   // Fastscan (CiA-305 8.4.2): finds the identity of one unconfigured slave in waiting state and
   // leaves that slave in configuration state. `step_timeout_ms` bounds the wait for an answer
-  // to each probe (no answer is part of the algorithm). Fails when no slave answered.
+  // to each probe (no answer is part of the algorithm); a tenth of it (at least 2 ms) of quiet
+  // ends the draining of further slaves' late answers before the next probe. Fails when no
+  // slave answered.
   Result<LssIdentityNumbers> fastscan(int step_timeout_ms);
 
   // CiA-305 table 0 bit rates (kbit/s) to index; nullopt for others.
   static std::optional<uint8_t> bit_timing_index(uint32_t bit_rate_kbit);
 
  private:
-  Result<void> send(const std::array<uint8_t, 8>& data);
+  Result<void> send(const std::array<uint8_t, 8>& data, int settle_ms = 2);
   // The next answer with command specifier `command` within `timeout_ms`.
   std::optional<can::CanFrame> await(uint8_t command, int timeout_ms);
   LssResult confirmed(const std::array<uint8_t, 8>& request, const char* what);
