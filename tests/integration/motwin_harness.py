@@ -526,8 +526,9 @@ class Server:
         return self.proc is not None and self.proc.poll() is None
 
     def bytes_read(self):
-        """Bytes the server process has read so far (rchar of /proc/PID/io: its pty, sockets and
-        files; a pty read in packet mode counts one status byte more)."""
+        """Bytes the server process has read so far with read() (rchar of /proc/PID/io: its pty
+        and files, not what recv() takes from sockets; a pty read in packet mode counts one
+        status byte more)."""
         with open(f"/proc/{self.proc.pid}/io") as f:
             for line in f:
                 if line.startswith("rchar:"):

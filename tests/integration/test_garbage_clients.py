@@ -59,9 +59,10 @@ from motwin_harness import (  # noqa: E402
 CHECKSUM_ERROR_REPLY = bytes.fromhex("02 01 01 00 00 00 00 00 04")
 TCP_RESYNC_PAUSE = 0.5  # 5 x the server's TCP resync gap (100 ms, src/host/tcp_server.h): room for a stall
 SERIAL_RESYNC_GAP = 0.005  # a pause this long between two bytes drops a partial frame (core/tmcl/serial_link.h)
-# A pause meant to resync the serial link, once the server has read what came before (it counts
-# only silence it saw itself, src/host/event_loop.h): 10 x the gap, room for a descheduled server.
-PTY_RESYNC_PAUSE = 0.05
+# A pause meant to resync the serial link, once the server has read what came before: it counts
+# only the silence its polls saw (src/host/event_loop.h), so a poll must start at least 5 ms after
+# the read. 40 x the gap: room for a server descheduled on a loaded machine.
+PTY_RESYNC_PAUSE = 0.2
 ENTER_ASCII = 139
 
 

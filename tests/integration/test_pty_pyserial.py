@@ -56,7 +56,7 @@ def test_pty_reopen(motwin):
                     read_before = server.bytes_read()
                     client.send_raw(frame(GAP, 43)[:4])
                     server.wait_until_read(read_before + 4)
-                time.sleep(0.05)
+                time.sleep(0.2)  # 40 x the resync gap: a poll of the server starts in it
             with server.serial() as client:
                 expect_reply(client.request(GAP, 43), GAP, 100, 1002, "GAP 43 after reopening")
             server.stop()
