@@ -127,10 +127,10 @@ class CanopenClient:
 
     # Simulated time ---------------------------------------------------------------------------------
     def frames_until_marker(self, node, predicate=lambda msg: True):
-        """Sends a marker to `node` and returns the frames matching predicate
-        that arrive before its answer: the node handles frames in the order the bus carries them
-        and answers an SDO request at once, so what it did for every frame sent before the marker
-        (a TPDO at a SYNC, say) is among them. The node must answer SDO (not stopped)."""
+        """Sends a marker to `node` and returns the frames matching predicate that arrive before
+        its answer: the node handles frames in the order the bus carries them and answers an SDO
+        request at once, so what it did for every frame sent before the marker (a TPDO at a
+        SYNC, say) is among them. The node must answer SDO (not stopped)."""
         frames = []
         self._marker(node, predicate, frames)
         return frames
