@@ -449,7 +449,27 @@ def test_tmcm142_ascii_tcp_misbehaving_clients(motwin):
 # --- CAN endpoints: socketcand and SLCAN over TCP -----------------------------------------------
 
 CAN_NODE = 5
-FLOOD_FRAMES = 150_000
+SLCAN_DATA_FRAME_BYTES = len("t12380102030405060708\r")
+SERVER_MAX_PENDING_OUTPUT = 1024 * 1024  # kMaxPendingOutputBytes of src/host/slcan_server.h and socketcand_server.h
+
+
+def kernel_send_buffer_limit():
+    """The most the kernel may buffer for one TCP sender (autotuning stops at tcp_wmem's maximum)."""
+    try:
+        with open("/proc/sys/net/ipv4/tcp_wmem") as f:
+            return int(f.read().split()[2])
+    except (OSError, ValueError, IndexError):
+        return 4 * 1024 * 1024
+
+
+def frames_to_overflow_a_never_reading_client():
+    """A flood big enough that a never-reading SLCAN client's output passes the server's limit even
+    when the kernel has taken all it may into the socket buffers (the shortest line is SLCAN's)."""
+    worst_case_bytes = kernel_send_buffer_limit() + SERVER_MAX_PENDING_OUTPUT + 64 * 1024
+    return (worst_case_bytes * 5 // 4) // SLCAN_DATA_FRAME_BYTES // 1000 * 1000 + 1000
+
+
+FLOOD_FRAMES = frames_to_overflow_a_never_reading_client()
 SLCAN_UPLOAD_1000 = slcan_line(0x600 + CAN_NODE, UPLOAD_1000)
 SLCAN_ANSWER_1000 = slcan_line(0x580 + CAN_NODE, ANSWER_1000) + "\r"
 
