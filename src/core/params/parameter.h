@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
+#include <utility>
 
 #include "core/tmcl/status.h"
 
@@ -147,16 +149,26 @@ struct Binding {
   tmcl::Status (*set)(Owner& owner, uint8_t axis, int32_t value) = nullptr;
 };
 
+// The types a plain field behind a row may have: the wire's 32 bits, signed or unsigned, or an
+// enum over int32_t whose named values are the manual's numbers (a mode: `CommutationMode`).
+// The row's range decides which numbers reach the field, so an enum also keeps numbers it does
+// not name (the manual allows them) and reads them back unchanged.
+template <class Value>
+concept WireField = std::is_same_v<Value, int32_t> || std::is_same_v<Value, uint32_t> ||
+                    (std::is_enum_v<Value> && std::is_same_v<std::underlying_type_t<Value>, int32_t>);
+
 // A binding to one plain field of a part of the owner: `Part` is a function returning that part
 // (for example the axis config struct), `Field` a pointer to the member. Writable fields store
 // the value as it comes; read-only ones (Writable = false) reject writes.
 template <class Owner, auto Part, auto Field, bool Writable = true>
 constexpr Binding<Owner> field_binding() {
+  using Value = std::remove_cvref_t<decltype(Part(std::declval<Owner&>()).*Field)>;
+  static_assert(WireField<Value>, "a parameter field is int32_t, uint32_t or an enum over int32_t");
   Binding<Owner> binding;
   binding.get = [](Owner& owner, uint8_t) { return static_cast<int32_t>(Part(owner).*Field); };
   if constexpr (Writable) {
     binding.set = [](Owner& owner, uint8_t, int32_t value) {
-      Part(owner).*Field = value;
+      Part(owner).*Field = static_cast<Value>(value);
       return tmcl::Status::kOk;
     };
   }

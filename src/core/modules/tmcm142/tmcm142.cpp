@@ -45,14 +45,14 @@ void Tmcm142::clear_ram_state() {
 // before anything is restored. Then AP 255 first: the stored speeds are in its units.
 void Tmcm142::before_axis_restore() {
   if (stored_value(kNvmLayout.global_parameter(kGpEepromMagic)) != kEepromMagic) restore_factory_defaults();
-  const int32_t unit_mode = stored_value(kNvmLayout.axis_parameter(0, kApUnitMode));
-  if (unit_mode == 0 || unit_mode == 1) axis_.config.unit_mode = unit_mode;
+  const auto unit_mode = static_cast<UnitMode>(stored_value(kNvmLayout.axis_parameter(0, kApUnitMode)));
+  if (unit_mode == UnitMode::kTmc457 || unit_mode == UnitMode::kMicrostepsPerSecond) axis_.config.unit_mode = unit_mode;
 }
 
 // GP 73 and, with GP 84 = 1, the coordinates come back from the image.
 void Tmcm142::after_restore() {
   eeprom_locked_ = stored_value(kNvmLayout.global_parameter(kGpEepromLock)) == 1;
-  if (global_.coordinate_storage != 0) {
+  if (global_.coordinate_storage == CoordinateStorage::kEeprom) {
     for (uint8_t n = 1; n < kCoordinateCount; ++n) load_coordinate(n);
   }
 }
@@ -164,7 +164,7 @@ Status Tmcm142::set_coordinate(uint8_t number, uint8_t motor, int32_t position) 
     return Status::kOk;
   }
   if (motor >= kMotorCount) return Status::kInvalidValue;
-  const bool stored = global_.coordinate_storage != 0 && number != 0;
+  const bool stored = global_.coordinate_storage == CoordinateStorage::kEeprom && number != 0;
   if (stored && eeprom_locked_) return Status::kEepromLocked;
   const int32_t previous = coordinates_[number];
   coordinates_[number] = position;

@@ -23,6 +23,9 @@
 
 namespace motwin::modules::tmcm142 {
 
+// GP 84: where coordinates 1..20 live.
+enum class CoordinateStorage : int32_t { kRam = 0, kEeprom = 1 };
+
 // Bank 0 settings (notes/tmcm142.md, TMCM-351 V4.45 as the same generation's stand-in).
 struct GlobalConfig {
   int32_t eeprom_magic = 228;          // GP 64: another value re-initialises the image at power-up
@@ -35,7 +38,7 @@ struct GlobalConfig {
   int32_t telegram_pause_ms = 0;       // GP 75
   int32_t serial_host_address = 2;     // GP 76
   int32_t auto_start_mode = 1;         // GP 77
-  int32_t coordinate_storage = 0;      // GP 84: 0 RAM (copies on request), 1 EEPROM
+  CoordinateStorage coordinate_storage = CoordinateStorage::kRam;  // GP 84: RAM copies on request
   int32_t skip_user_variable_restore = 0;  // GP 85
 };
 

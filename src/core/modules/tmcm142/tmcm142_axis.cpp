@@ -80,7 +80,7 @@ void Tmcm142Axis::set_encoder_position(int32_t position) {
 void Tmcm142Axis::start_reference_search() {
   switch_stopping_ = false;
   search_final_move_ = false;
-  const auto command = search_.start(config.reference_mode, config.reference_fast_pps, config.reference_slow_pps);
+  const auto command = search_.start(static_cast<int32_t>(config.reference_mode), config.reference_fast_pps, config.reference_slow_pps);
   ramp_.set_velocity_target(command.velocity);
 }
 
@@ -111,7 +111,7 @@ bool Tmcm142Axis::take_deviation_event() {
 
 int64_t Tmcm142Axis::pid_velocity_internal() const {
   const double v = std::round(ramp_.velocity() / kPpsPerVelocityUnit);
-  const int64_t with_correction = static_cast<int64_t>(v) + (config.pid_mode != 0 ? pid_.correction : 0);
+  const int64_t with_correction = static_cast<int64_t>(v) + (config.pid_mode == PidMode::kEasyPid ? pid_.correction : 0);
   if (with_correction > INT32_MAX) return INT32_MAX;
   if (with_correction < INT32_MIN) return INT32_MIN;
   return with_correction;
@@ -248,7 +248,7 @@ void Tmcm142Axis::tick(board::StepperPowerStage& stage) {
   const auto ramp_delta_q32 = static_cast<int64_t>(ramp_q32 - last_ramp_q32_);
   last_ramp_q32_ = ramp_q32;
 
-  if (config.pid_mode != 0) {
+  if (config.pid_mode == PidMode::kEasyPid) {
     const int64_t error =
         static_cast<int32_t>(static_cast<uint32_t>(state.encoder_position) - static_cast<uint32_t>(ramp_.position()));
     const auto d_ticks = static_cast<uint32_t>(std::lround(
@@ -273,7 +273,7 @@ void Tmcm142Axis::write_drive(board::StepperDrive& drive, int64_t ramp_delta_q32
   const uint32_t microsteps = microsteps_per_full_step();
   // µsteps in Q32 -> electrical angle in Q16: x 2^30 / microsteps / 2^32 x 2^16.
   int64_t delta_q32 = ramp_delta_q32;
-  if (config.pid_mode != 0) {
+  if (config.pid_mode == PidMode::kEasyPid) {
     delta_q32 += static_cast<int64_t>(std::llround(pid_.correction * kPpsPerVelocityUnit * kControlTickS * kQ32));
   }
   angle_q16_ += static_cast<uint64_t>(delta_q32 * 16384 / static_cast<int64_t>(microsteps));

@@ -21,6 +21,14 @@ inline constexpr int32_t kDefaultAcceleration = 14073;        // AP 5: 204786 µ
 inline constexpr int32_t kDefaultBow = 1000;                  // AP 16..19: 1.42e7 µsteps/s³
 inline constexpr int32_t kDefaultReferenceSlow = kDefaultMaxVelocity / 4;  // AP 195
 
+// The mode parameters as named values; each enumerator is the number on the wire.
+// AP 40.
+enum class PidMode : int32_t { kOpenLoop = 0, kEasyPid = 1 };
+// AP 193: the switches a reference search uses (core/motion/reference_search.h takes the number).
+enum class ReferenceSearchMode : int32_t { kLeftSwitch = 1, kRightThenLeftSwitch = 2, kCentreOfLeftSwitch = 3 };
+// AP 255: the units of speeds and accelerations on the wire.
+enum class UnitMode : int32_t { kTmc457 = 0, kMicrostepsPerSecond = 1 };
+
 // Stored settings (the E parameters). Velocities and accelerations are kept in µsteps/s and
 // µsteps/s² whatever the unit mode, so AP 255 changes only how they are read and written.
 struct AxisConfig {
@@ -35,15 +43,15 @@ struct AxisConfig {
   int32_t bow[4] = {kDefaultBow, kDefaultBow, kDefaultBow, kDefaultBow};             // AP 16..19
   int32_t microstep_code = kFinestResolutionCode;  // AP 27
   motion::EasyPidConfig pid{65536, 0, 0, 0, 0, 67108864};  // AP 30, 31, 32, 33, 35, 37
-  int32_t pid_mode = 0;                   // AP 40
+  PidMode pid_mode = PidMode::kOpenLoop;  // AP 40
   int32_t encoder_constant = 3355443;     // AP 42: µsteps per encoder count * 65536 (51.2)
   int32_t encoder_direction = 0;          // AP 46
-  int32_t reference_mode = 1;             // AP 193
+  ReferenceSearchMode reference_mode = ReferenceSearchMode::kLeftSwitch;  // AP 193
   double reference_fast_pps = kDefaultMaxVelocity * kPpsPerVelocityUnit;    // AP 194
   double reference_slow_pps = kDefaultReferenceSlow * kPpsPerVelocityUnit;  // AP 195
   int32_t max_encoder_deviation = 0;      // AP 212, µsteps; 0 = off
   int32_t standby_delay_10ms = 200;       // AP 214
-  int32_t unit_mode = 0;                  // AP 255
+  UnitMode unit_mode = UnitMode::kTmc457;  // AP 255
 };
 
 // AP 14 bits.

@@ -24,7 +24,7 @@ AxisConfig& axis_config(Tmcm142& m) { return m.axis().config; }
 motion::EasyPidConfig& pid_config(Tmcm142& m) { return m.axis().config.pid; }
 GlobalConfig& global_config(Tmcm142& m) { return m.global_config(); }
 
-template <int32_t AxisConfig::*Field>
+template <auto Field>
 constexpr Binding<Tmcm142> config_field() {
   return params::field_binding<Tmcm142, axis_config, Field>();
 }
@@ -32,7 +32,7 @@ template <int32_t motion::EasyPidConfig::*Field>
 constexpr Binding<Tmcm142> pid_field() {
   return params::field_binding<Tmcm142, pid_config, Field>();
 }
-template <int32_t GlobalConfig::*Field>
+template <auto Field>
 constexpr Binding<Tmcm142> global_field() {
   return params::field_binding<Tmcm142, global_config, Field>();
 }
@@ -43,7 +43,7 @@ int32_t clamp_to_int32(double v) {
   return static_cast<int32_t>(std::lround(v));
 }
 
-bool pps_mode(const Tmcm142& m) { return m.axis().config.unit_mode != 0; }
+bool pps_mode(const Tmcm142& m) { return m.axis().config.unit_mode == UnitMode::kMicrostepsPerSecond; }
 
 // Speeds: TMC457 units (v * fCLK / 2^32 µsteps/s) or µsteps/s up to 31999999.
 int32_t speed_to_wire(const Tmcm142& m, double pps) {

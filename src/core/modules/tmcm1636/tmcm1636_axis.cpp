@@ -73,15 +73,16 @@ void Tmcm1636Axis::set_driver_enabled(bool enabled) {
   }
 }
 
-void Tmcm1636Axis::set_commutation_mode(int32_t mode) {
+void Tmcm1636Axis::set_commutation_mode(CommutationMode mode) {
   config.commutation_mode = mode;
   if (restoring_ || power_stage_ == nullptr) return;
-  if (mode == 3) {
+  if (mode == CommutationMode::kAbnEncoder) {
     start_encoder_init(false);
-  } else if (mode == 4 && config.absolute_encoder_init == 0) {
+  } else if (mode == CommutationMode::kAbsoluteEncoder &&
+             config.absolute_encoder_init == AbsoluteEncoderInit::kEstimateOffset) {
     start_encoder_init(true);
   } else {
-    state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kIdle);
+    state.encoder_init_state = EncoderInitState::kIdle;
   }
 }
 

@@ -20,6 +20,27 @@
 
 namespace motwin::modules::tmcm1636 {
 
+// The mode parameters of table 11 as named values. Each enumerator is the manual's number, so
+// the wire values, ranges, defaults and EEPROM slots are those of the table; a number the range
+// allows but the manual does not name (motor type 2) is kept as it is.
+// AP 14.
+enum class MotorType : int32_t { kNone = 0, kDc = 1, kBldc = 3 };
+// AP 15: the source of the electrical angle the FOC turns the field with.
+enum class CommutationMode : int32_t { kDisabled = 0, kOpenLoop = 1, kDigitalHall = 2, kAbnEncoder = 3, kAbsoluteEncoder = 4 };
+// AP 25: the source of the position counter (AP 52).
+enum class PositionCommutationMode : int32_t { kSameAsCommutation = 0, kAbnEncoder = 1, kAbsoluteEncoder = 2 };
+// AP 102: how the ABN encoder initialisation finds the commutation offset.
+enum class EncoderInitMode : int32_t { kEstimateOffset = 0, kNChannel = 1, kUseHall = 2 };
+// AP 160.
+enum class AbsoluteEncoderType : int32_t { kNone = 0, kAmt20 = 1, kAmt23 = 2 };
+// AP 161.
+enum class AbsoluteEncoderInit : int32_t { kEstimateOffset = 0, kUseOffset = 1 };
+// AP 124, named as the manual's values read: 0 enables the brake output function.
+enum class BrakeOutput : int32_t { kEnabled = 0, kDisabled = 1 };
+// AP 125: 0 (the manual's "inverted", its default) drives the connector as computed, 1 (its
+// "normal") complements the duty (docs/tmcm-1636-servo.md).
+enum class BrakeOutputPolarity : int32_t { kAsComputed = 0, kComplemented = 1 };
+
 // Stored settings of the axis, one field per writable row of table 11. Defaults are the
 // manual's, except where docs/tmcm-1636.md records a decision.
 struct AxisConfig {
@@ -29,9 +50,9 @@ struct AxisConfig {
   int32_t motor_pole_pairs = 4;              // AP 10
   int32_t max_current_ma = 2000;             // AP 11
   int32_t open_loop_current_ma = 2000;       // AP 12
-  int32_t motor_type = 0;                    // AP 14: 0 none, 1 DC, 3 BLDC
-  int32_t commutation_mode = 0;              // AP 15
-  int32_t position_commutation_mode = 0;     // AP 25
+  MotorType motor_type = MotorType::kNone;   // AP 14
+  CommutationMode commutation_mode = CommutationMode::kDisabled;  // AP 15
+  PositionCommutationMode position_commutation_mode = PositionCommutationMode::kSameAsCommutation;  // AP 25
   int32_t max_velocity_rpm = 4000;           // AP 43
   int32_t acceleration_rpm_per_s = 2000;     // AP 44
   int32_t velocity_ramp_enabled = 1;         // AP 45
@@ -46,7 +67,7 @@ struct AxisConfig {
   int32_t hall_phi_e_offset = 0;             // AP 93
   int32_t encoder_steps = 8192;              // AP 100, counts per revolution
   int32_t encoder_direction = 0;             // AP 101
-  int32_t encoder_init_mode = 1;             // AP 102: 0 estimate, 1 N channel, 2 hall
+  EncoderInitMode encoder_init_mode = EncoderInitMode::kNChannel;  // AP 102
   int32_t encoder_init_delay_ms = 1000;      // AP 104
   int32_t encoder_init_velocity_rpm = 100;   // AP 105
   int32_t encoder_offset = 0;                // AP 106
@@ -56,13 +77,13 @@ struct AxisConfig {
   int32_t brake_release_duty_percent = 75;   // AP 121
   int32_t brake_hold_duty_percent = 11;      // AP 122
   int32_t brake_release_duration_ms = 80;    // AP 123
-  int32_t brake_output_enable = 0;           // AP 124 (manual: 0 enabled, 1 disabled)
-  int32_t brake_output_invert = 0;           // AP 125 (manual: 0 "inverted", 1 "normal")
+  BrakeOutput brake_output = BrakeOutput::kEnabled;  // AP 124
+  BrakeOutputPolarity brake_output_polarity = BrakeOutputPolarity::kAsComputed;  // AP 125
   int32_t brake_chopper_enabled = 0;         // AP 140
   int32_t brake_chopper_limit_decivolt = 260;     // AP 141
   int32_t brake_chopper_hysteresis_decivolt = 5;  // AP 142
-  int32_t absolute_encoder_type = 0;         // AP 160: 0 none, 1 AMT20 (12 bit), 2 AMT23 (14 bit)
-  int32_t absolute_encoder_init = 0;         // AP 161: 0 estimate offset, 1 use AP 163
+  AbsoluteEncoderType absolute_encoder_type = AbsoluteEncoderType::kNone;  // AP 160: AMT20 12 bit, AMT23 14 bit
+  AbsoluteEncoderInit absolute_encoder_init = AbsoluteEncoderInit::kEstimateOffset;  // AP 161
   int32_t absolute_encoder_direction = 0;    // AP 162
   int32_t absolute_encoder_offset = 0;       // AP 163, 65536 per mechanical revolution
   int32_t reference_switch_enable = 0;       // AP 209: bit 0 right, bit 1 left
@@ -132,7 +153,7 @@ struct AxisState {
   motion::PiState flux_pi;          // AP 76, 79
   motion::PiState velocity_pi;      // AP 77, 80
   motion::PiState position_pi;      // AP 81
-  int32_t encoder_init_state = 0;   // AP 103
+  EncoderInitState encoder_init_state = EncoderInitState::kIdle;  // AP 103
   int32_t release_brake = 0;        // AP 120
   int32_t brake_chopper_active = 0;  // AP 144 (the manual's default column says 255)
   uint32_t status_flags = 0;        // AP 156, status_flag bits
@@ -158,9 +179,9 @@ class Tmcm1636Axis {
   void set_target_torque(int32_t torque_ma);
   void set_target_flux(int32_t flux_ma);
   void set_driver_enabled(bool enabled);
-  // AP 15: selecting ABN (3) or absolute encoder (4, AP 161 = 0) commutation starts the
+  // AP 15: selecting ABN or absolute encoder commutation (with AP 161 = estimate) starts the
   // encoder initialisation; restoring AP 15 at power-up does not (docs/tmcm-1636-servo.md).
-  void set_commutation_mode(int32_t mode);
+  void set_commutation_mode(CommutationMode mode);
   // AP 107: writing it re-arms the clear on the next N pulse.
   void set_clear_on_null(int32_t clear);
 

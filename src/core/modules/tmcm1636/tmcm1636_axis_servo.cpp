@@ -63,7 +63,7 @@ enum class PositionSource : uint8_t { kAbn, kHall, kAbsolute, kOpenLoop };
 void Tmcm1636Axis::start_encoder_init(bool absolute) {
   servo_.init_for_absolute = absolute;
   servo_.init_ticks = 0;
-  state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kStartInit);
+  state.encoder_init_state = EncoderInitState::kStartInit;
   if (absolute) {
     servo_.absolute_estimated = false;
   } else {
@@ -99,8 +99,8 @@ void Tmcm1636Axis::read_sensors(const board::Tmcm1636Feedback& feedback, double 
   const motion::HallConfig hall_config{config.hall_polarity != 0, config.hall_direction != 0,
                                        config.hall_interpolation != 0, config.hall_phi_e_offset};
   uint16_t absolute = feedback.absolute_angle;
-  if (config.absolute_encoder_type == 1) absolute &= 0xFFF0;  // AMT20: 12 bits
-  if (config.absolute_encoder_type == 2) absolute &= 0xFFFC;  // AMT23: 14 bits
+  if (config.absolute_encoder_type == AbsoluteEncoderType::kAmt20) absolute &= 0xFFF0;  // 12 bits
+  if (config.absolute_encoder_type == AbsoluteEncoderType::kAmt23) absolute &= 0xFFFC;  // 14 bits
   if (config.absolute_encoder_direction != 0) absolute = static_cast<uint16_t>(-absolute);
   if (!s.started) {
     s.started = true;
@@ -134,7 +134,7 @@ void Tmcm1636Axis::read_sensors(const board::Tmcm1636Feedback& feedback, double 
   s.hall_last_steps = s.hall.steps();
 
   int64_t absolute_delta = 0;
-  if (config.absolute_encoder_type != 0 && feedback.absolute_valid) {
+  if (config.absolute_encoder_type != AbsoluteEncoderType::kNone && feedback.absolute_valid) {
     absolute_delta = static_cast<int16_t>(static_cast<uint16_t>(absolute - s.absolute_last));
     s.absolute_last = absolute;
   }
@@ -143,18 +143,20 @@ void Tmcm1636Axis::read_sensors(const board::Tmcm1636Feedback& feedback, double 
 
   // The position source: AP 25, or with AP 25 = 0 the commutation sensor (docs/tmcm-1636-servo.md).
   PositionSource source = PositionSource::kAbn;
-  if (config.motor_type == 1) {
-    source = config.commutation_mode == 4 || config.position_commutation_mode == 2 ? PositionSource::kAbsolute
-                                                                                   : PositionSource::kAbn;
-  } else if (config.position_commutation_mode == 1) {
+  if (config.motor_type == MotorType::kDc) {
+    source = config.commutation_mode == CommutationMode::kAbsoluteEncoder ||
+                     config.position_commutation_mode == PositionCommutationMode::kAbsoluteEncoder
+                 ? PositionSource::kAbsolute
+                 : PositionSource::kAbn;
+  } else if (config.position_commutation_mode == PositionCommutationMode::kAbnEncoder) {
     source = PositionSource::kAbn;
-  } else if (config.position_commutation_mode == 2) {
+  } else if (config.position_commutation_mode == PositionCommutationMode::kAbsoluteEncoder) {
     source = PositionSource::kAbsolute;
-  } else if (config.commutation_mode == 1) {
+  } else if (config.commutation_mode == CommutationMode::kOpenLoop) {
     source = PositionSource::kOpenLoop;
-  } else if (config.commutation_mode == 2) {
+  } else if (config.commutation_mode == CommutationMode::kDigitalHall) {
     source = PositionSource::kHall;
-  } else if (config.commutation_mode == 4) {
+  } else if (config.commutation_mode == CommutationMode::kAbsoluteEncoder) {
     source = PositionSource::kAbsolute;
   }
   const int64_t steps = config.encoder_steps;
@@ -195,19 +197,19 @@ void Tmcm1636Axis::read_sensors(const board::Tmcm1636Feedback& feedback, double 
 
   // Encoder initialisation waiting for the N pulse: the offset relative to the pulse, from the
   // field angle the rotor follows in open loop (the rotor lags it by its small load angle).
-  if (index_now && state.encoder_init_state == static_cast<int32_t>(EncoderInitState::kWaitInitTime) &&
-      !s.init_for_absolute && config.encoder_init_mode == 1 && steps > 0 && pole_pairs > 0) {
+  if (index_now && state.encoder_init_state == EncoderInitState::kWaitInitTime && !s.init_for_absolute &&
+      config.encoder_init_mode == EncoderInitMode::kNChannel && steps > 0 && pole_pairs > 0) {
     s.abn_reference = s.abn_count - counts_since_index;
     const int64_t field = (s.open_loop_phase >> 16) * steps / (pole_pairs * 65536);
     config.encoder_offset = static_cast<int32_t>(positive_mod(counts_since_index - field, steps));
-    state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kEstimateOffset);
+    state.encoder_init_state = EncoderInitState::kEstimateOffset;
   }
   // "Use hall": the first hall edge is an exact electrical angle.
-  if (s.hall.edge() && state.encoder_init_state == static_cast<int32_t>(EncoderInitState::kWaitInitTime) &&
-      !s.init_for_absolute && config.encoder_init_mode == 2 && steps > 0 && pole_pairs > 0) {
+  if (s.hall.edge() && state.encoder_init_state == EncoderInitState::kWaitInitTime && !s.init_for_absolute &&
+      config.encoder_init_mode == EncoderInitMode::kUseHall && steps > 0 && pole_pairs > 0) {
     const int64_t edge = static_cast<int64_t>(s.hall.edge_angle()) * steps / (pole_pairs * 65536);
     config.encoder_offset = static_cast<int32_t>(positive_mod(s.abn_count - s.abn_reference - edge, steps));
-    state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kEstimateOffset);
+    state.encoder_init_state = EncoderInitState::kEstimateOffset;
   }
 }
 
@@ -216,16 +218,15 @@ void Tmcm1636Axis::read_sensors(const board::Tmcm1636Feedback& feedback, double 
 bool Tmcm1636Axis::run_encoder_init(const board::Tmcm1636Feedback& /*feedback*/, uint16_t& angle, float& id_ref,
                                     double dt_s) {
   Servo& s = servo_;
-  const auto init_state = static_cast<EncoderInitState>(state.encoder_init_state);
-  const bool estimate = s.init_for_absolute || config.encoder_init_mode == 0;
-  const bool index_search = !s.init_for_absolute && config.encoder_init_mode == 1;
-  switch (init_state) {
+  const bool estimate = s.init_for_absolute || config.encoder_init_mode == EncoderInitMode::kEstimateOffset;
+  const bool index_search = !s.init_for_absolute && config.encoder_init_mode == EncoderInitMode::kNChannel;
+  switch (state.encoder_init_state) {
     case EncoderInitState::kIdle:
       return false;
     case EncoderInitState::kStartInit:
       reset_regulators();
       s.init_ticks = 0;
-      state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kWaitInitTime);
+      state.encoder_init_state = EncoderInitState::kWaitInitTime;
       break;
     case EncoderInitState::kWaitInitTime: {
       if (estimate) {
@@ -234,7 +235,7 @@ bool Tmcm1636Axis::run_encoder_init(const board::Tmcm1636Feedback& /*feedback*/,
         const uint32_t ticks = static_cast<uint32_t>(config.encoder_init_delay_ms) * (kTicksPerSecond / 1000);
         angle = s.init_ticks < ticks / 2 ? 16384 : 0;
         id_ref = static_cast<float>(config.open_loop_current_ma);
-        if (++s.init_ticks >= ticks) state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kEstimateOffset);
+        if (++s.init_ticks >= ticks) state.encoder_init_state = EncoderInitState::kEstimateOffset;
         return true;
       }
       if (index_search) {
@@ -258,7 +259,7 @@ bool Tmcm1636Axis::run_encoder_init(const board::Tmcm1636Feedback& /*feedback*/,
         }
       }
       if (!s.init_for_absolute) s.abn_initialised = true;
-      state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kIdle);
+      state.encoder_init_state = EncoderInitState::kIdle;
       reset_regulators();
       seed_ramp();
       if (state.mode == MotionMode::kPosition) ramp_.set_position_target(ramp_.target_position());
@@ -305,11 +306,12 @@ void Tmcm1636Axis::update_brake(board::Tmcm1636Drive& drive, double dt_s) {
   }
   // AP 124: 0 enables the function (manual). AP 125 = 0, the manual's "inverted" and its
   // default, drives the connector as computed; 1 complements it (docs/tmcm-1636-servo.md).
-  if (config.brake_output_enable != 0) {
+  if (config.brake_output == BrakeOutput::kDisabled) {
     drive.brake_duty_percent = 0;
     return;
   }
-  drive.brake_duty_percent = static_cast<uint8_t>(config.brake_output_invert == 0 ? duty : 100 - duty);
+  drive.brake_duty_percent =
+      static_cast<uint8_t>(config.brake_output_polarity == BrakeOutputPolarity::kAsComputed ? duty : 100 - duty);
 }
 
 // The velocity demand of velocity and position modes (rpm): ramp generator (AP 44/45),
@@ -320,7 +322,7 @@ float Tmcm1636Axis::velocity_reference_rpm(double dt_s) {
       to_counts_per_s(config.acceleration_rpm_per_s),
       config.velocity_ramp_enabled != 0,
   };
-  const bool open_loop = config.motor_type == 3 && config.commutation_mode == 1;
+  const bool open_loop = config.motor_type == MotorType::kBldc && config.commutation_mode == CommutationMode::kOpenLoop;
   double velocity_rpm = 0.0;
   if (state.mode == MotionMode::kVelocity) {
     ramp_.set_velocity_target(to_counts_per_s(state.target_velocity_rpm));
@@ -381,13 +383,13 @@ void Tmcm1636Axis::servo_tick(board::Tmcm1636PowerStage& stage, double dt_s) {
   drive.pwm_frequency_hz = static_cast<uint32_t>(config.pwm_frequency_hz);
   update_brake(drive, dt_s);
 
-  const bool bldc = config.motor_type == 3;
-  const bool dc = config.motor_type == 1;
-  const int32_t commutation = config.commutation_mode;
+  const bool bldc = config.motor_type == MotorType::kBldc;
+  const bool dc = config.motor_type == MotorType::kDc;
+  const CommutationMode commutation = config.commutation_mode;
   const bool fault = s.undervoltage || s.overvoltage || s.overtemperature;
   // Only a BLDC motor has a commutation offset to find.
-  if (!bldc) state.encoder_init_state = static_cast<int32_t>(EncoderInitState::kIdle);
-  const bool bridge = state.driver_enabled != 0 && (bldc || dc) && commutation != 0 && !fault;
+  if (!bldc) state.encoder_init_state = EncoderInitState::kIdle;
+  const bool bridge = state.driver_enabled != 0 && (bldc || dc) && commutation != CommutationMode::kDisabled && !fault;
 
   if (!bridge) {
     reset_regulators();
@@ -405,12 +407,12 @@ void Tmcm1636Axis::servo_tick(board::Tmcm1636PowerStage& stage, double dt_s) {
     float iq_ref = 0.0f;
     bool field_driven = false;  // angle and flux current set by open loop or initialisation
     double electrical_turns_per_s = s.velocity_counts_per_s * s.inverse_encoder_steps * config.motor_pole_pairs;
-    if (bldc && state.encoder_init_state != static_cast<int32_t>(EncoderInitState::kIdle)) {
+    if (bldc && state.encoder_init_state != EncoderInitState::kIdle) {
       field_driven = run_encoder_init(feedback, angle, id_ref, dt_s);
       if (field_driven) electrical_turns_per_s = 0.0;
     }
     if (!field_driven) {
-      const bool open_loop = bldc && commutation == 1;
+      const bool open_loop = bldc && commutation == CommutationMode::kOpenLoop;
       if (state.mode == MotionMode::kTorque) {
         iq_ref = static_cast<float>(clamp_i32(state.target_torque_ma, config.max_current_ma));
         id_ref = static_cast<float>(clamp_i32(state.target_flux_ma, config.max_current_ma));
@@ -439,13 +441,15 @@ void Tmcm1636Axis::servo_tick(board::Tmcm1636PowerStage& stage, double dt_s) {
         }
       }
       switch (commutation) {
-        case 1: angle = static_cast<uint16_t>(s.open_loop_phase >> 16); break;
-        case 2: angle = s.hall.angle(); break;
-        case 3:
+        case CommutationMode::kOpenLoop: angle = static_cast<uint16_t>(s.open_loop_phase >> 16); break;
+        case CommutationMode::kDigitalHall: angle = s.hall.angle(); break;
+        case CommutationMode::kAbnEncoder:
           // "Use hall" initialisation: hall commutation until the first edge.
-          angle = state.encoder_init_state != 0 && config.encoder_init_mode == 2 ? s.hall.angle() : abn_angle();
+          angle = state.encoder_init_state != EncoderInitState::kIdle && config.encoder_init_mode == EncoderInitMode::kUseHall
+                      ? s.hall.angle()
+                      : abn_angle();
           break;
-        case 4: angle = absolute_angle(s.absolute_last); break;
+        case CommutationMode::kAbsoluteEncoder: angle = absolute_angle(s.absolute_last); break;
         default: break;
       }
     }
@@ -505,13 +509,15 @@ void Tmcm1636Axis::servo_tick(board::Tmcm1636PowerStage& stage, double dt_s) {
                                                  : status_flag::kVelocityMode;
   if (state.position_reached != 0) flags |= status_flag::kPositionReached;
   if (s.abn_initialised) flags |= status_flag::kEncoderInitialised;
-  if (state.encoder_init_state != 0) flags |= status_flag::kEncoderInitRunning;
-  if (config.absolute_encoder_type != 0 && (config.absolute_encoder_init == 1 || s.absolute_estimated)) {
+  if (state.encoder_init_state != EncoderInitState::kIdle) flags |= status_flag::kEncoderInitRunning;
+  if (config.absolute_encoder_type != AbsoluteEncoderType::kNone &&
+      (config.absolute_encoder_init == AbsoluteEncoderInit::kUseOffset || s.absolute_estimated)) {
     flags |= status_flag::kAbsoluteEncoderReady;
   }
-  const bool hall_used = commutation == 2 || (commutation == 3 && config.encoder_init_mode == 2);
+  const bool hall_used = commutation == CommutationMode::kDigitalHall ||
+                         (commutation == CommutationMode::kAbnEncoder && config.encoder_init_mode == EncoderInitMode::kUseHall);
   if (hall_used && !s.hall.valid()) flags |= status_flag::kHallError;
-  if (state.release_brake != 0 && config.brake_output_enable == 0) flags |= status_flag::kBrakeReleased;
+  if (state.release_brake != 0 && config.brake_output == BrakeOutput::kEnabled) flags |= status_flag::kBrakeReleased;
   if (s.chopper_on) flags |= status_flag::kBrakeChopperActive;
   if (s.undervoltage) flags |= status_flag::kUndervoltage;
   if (s.overvoltage) flags |= status_flag::kOvervoltage;

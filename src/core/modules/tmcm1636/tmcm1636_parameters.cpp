@@ -25,7 +25,7 @@ AxisState& axis_state(Tmcm1636& m) { return m.axis().state; }
 GlobalConfig& global_config(Tmcm1636& m) { return m.global_config(); }
 
 // A stored setting of the axis: plain read and write.
-template <int32_t AxisConfig::*Field>
+template <auto Field>
 constexpr Binding<Tmcm1636> config_field() {
   return params::field_binding<Tmcm1636, axis_config, Field>();
 }
@@ -78,9 +78,9 @@ constexpr Binding<Tmcm1636> global_field() {
 
 // AP 15: selecting ABN or absolute encoder commutation starts the encoder initialisation.
 constexpr Binding<Tmcm1636> kCommutationMode{
-    [](Tmcm1636& m, uint8_t) { return m.axis().config.commutation_mode; },
+    [](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.axis().config.commutation_mode); },
     [](Tmcm1636& m, uint8_t, int32_t value) {
-      m.axis().set_commutation_mode(value);
+      m.axis().set_commutation_mode(static_cast<CommutationMode>(value));
       return Status::kOk;
     }};
 // AP 107: a write re-arms the clear at the next N pulse (AP 108 = 1 clears only once).
@@ -204,8 +204,8 @@ constexpr Row kAxisRows[] = {
   {{121, "brake releasing duty cycle", 0, 100, 75, access("RWEX"), Unit::kPercent, "Duty cycle of the releasing phase"}, config_field<&AxisConfig::brake_release_duty_percent>()},
   {{122, "brake holding duty cycle", 0, 100, 11, access("RWEX"), Unit::kPercent, "Duty cycle of the holding phase"}, config_field<&AxisConfig::brake_hold_duty_percent>()},
   {{123, "brake releasing duration", 0, 65535, 80, access("RWEX"), Unit::kMillisecond, "Duration of the releasing phase"}, config_field<&AxisConfig::brake_release_duration_ms>()},
-  {{124, "enable brake output", 0, 1, 0, access("RWEX"), Unit::kNone, "Brake output function (manual: 0 enabled, 1 disabled)"}, config_field<&AxisConfig::brake_output_enable>()},
-  {{125, "invert brake output", 0, 1, 0, access("RWEX"), Unit::kNone, "Brake output polarity (manual: 0 inverted, 1 normal)"}, config_field<&AxisConfig::brake_output_invert>()},
+  {{124, "enable brake output", 0, 1, 0, access("RWEX"), Unit::kNone, "Brake output function (manual: 0 enabled, 1 disabled)"}, config_field<&AxisConfig::brake_output>()},
+  {{125, "invert brake output", 0, 1, 0, access("RWEX"), Unit::kNone, "Brake output polarity (manual: 0 inverted, 1 normal)"}, config_field<&AxisConfig::brake_output_polarity>()},
   {{140, "enable brake chopper", 0, 1, 0, access("RWE"), Unit::kNone, "1 brake chopper active above its voltage limit"}, config_field<&AxisConfig::brake_chopper_enabled>()},
   {{141, "brake chopper voltage limit", 50, 600, 260, access("RWE"), Unit::kDecivolt, "Supply voltage above which the chopper switches on"}, config_field<&AxisConfig::brake_chopper_limit_decivolt>()},
   {{142, "brake chopper hysteresis", 0, 50, 5, access("RWE"), Unit::kDecivolt, "Chopper switches off below limit minus hysteresis"}, config_field<&AxisConfig::brake_chopper_hysteresis_decivolt>()},
