@@ -3,6 +3,7 @@
 // manuals' access columns live in one place.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -68,5 +69,32 @@ class ParameterTable {
  private:
   std::span<const Row> rows_;
 };
+
+namespace detail {
+template <class Rows>
+struct RowCount;
+template <class Row, size_t kCount>
+struct RowCount<Row[kCount]> {
+  static constexpr size_t value = kCount;
+};
+template <class Row, size_t kCount>
+struct RowCount<std::array<Row, kCount>> {
+  static constexpr size_t value = kCount;
+};
+}  // namespace detail
+
+// One row list from several, in the order given: a module's own rows and the rows a base
+// shares between modules (core/tmcl/tmcl_module.h). Parts are arrays or std::arrays of rows;
+// the table over the result checks the order like any other.
+template <class Owner, class... Parts>
+constexpr auto join_rows(const Parts&... parts) {
+  std::array<ParameterRow<Owner>, (detail::RowCount<Parts>::value + ...)> rows{};
+  size_t next = 0;
+  const auto append = [&](const auto& part) {
+    for (const ParameterRow<Owner>& row : part) rows[next++] = row;
+  };
+  (append(parts), ...);
+  return rows;
+}
 
 }  // namespace motwin::params

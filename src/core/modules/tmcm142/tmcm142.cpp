@@ -7,11 +7,6 @@ namespace {
 
 using tmcl::Status;
 
-// GIO/SIO banks, as on the TMCM-1636.
-constexpr uint8_t kIoBankDigitalInputs = 0;
-constexpr uint8_t kIoBankAnalogInputs = 1;
-constexpr uint8_t kIoBankDigitalOutputs = 2;
-
 // RFS types (notes/tmcl.md).
 constexpr uint8_t kRfsStart = 0;
 constexpr uint8_t kRfsStop = 1;
@@ -26,19 +21,11 @@ constexpr uint8_t kApUnitMode = 255;
 
 }  // namespace
 
-Tmcm142::Tmcm142(board::NonVolatileMemory& nvm, board::StepperPowerStage& stage, board::Tmcm142Io& io)
-    : ModuleStorage(nvm), stage_(stage), io_(io) {}
-
-// Power-up: the live state and every setting back to the defaults, before the restore.
+// Power-up: what the base clears, the EEPROM lock and the coordinates, before the restore.
 void Tmcm142::clear_ram_state() {
-  axis_.reset_state();
-  axis_.config = AxisConfig{};
-  global_ = GlobalConfig{};
+  TmclModule::clear_ram_state();
   eeprom_locked_ = false;
   coordinates_.fill(0);
-  runtime_ = tmcl::TmclRuntime{};
-  tick_timer_ms_ = 0;
-  tick_fraction_ = 0;
 }
 
 // GP 64 other than the magic value: the parameter part of the image goes back to factory values
@@ -46,13 +33,13 @@ void Tmcm142::clear_ram_state() {
 void Tmcm142::before_axis_restore() {
   if (stored_value(kNvmLayout.global_parameter(kGpEepromMagic)) != kEepromMagic) restore_factory_defaults();
   const auto unit_mode = static_cast<UnitMode>(stored_value(kNvmLayout.axis_parameter(0, kApUnitMode)));
-  if (unit_mode == UnitMode::kTmc457 || unit_mode == UnitMode::kMicrostepsPerSecond) axis_.config.unit_mode = unit_mode;
+  if (unit_mode == UnitMode::kTmc457 || unit_mode == UnitMode::kMicrostepsPerSecond) axis().config.unit_mode = unit_mode;
 }
 
 // GP 73 and, with GP 84 = 1, the coordinates come back from the image.
 void Tmcm142::after_restore() {
   eeprom_locked_ = stored_value(kNvmLayout.global_parameter(kGpEepromLock)) == 1;
-  if (global_.coordinate_storage == CoordinateStorage::kEeprom) {
+  if (global_config().coordinate_storage == CoordinateStorage::kEeprom) {
     for (uint8_t n = 1; n < kCoordinateCount; ++n) load_coordinate(n);
   }
 }
@@ -73,72 +60,29 @@ int32_t Tmcm142::next_random() {
   return static_cast<int32_t>(random_state_ & 0x7FFFFFFFu);
 }
 
-void Tmcm142::tick() {
-  axis_.tick(stage_);
-  if (axis_.take_deviation_event()) runtime_.error_flags |= tmcl::kErrorDeviation;
-  ++tick_count_;
-  if (++tick_fraction_ == kTicksPerMillisecond) {
-    tick_fraction_ = 0;
-    ++tick_timer_ms_;
-  }
-  engine_.tick(tick_count_ * kControlTickUs);
-}
-
-tmcl::SerialSettings Tmcm142::serial_settings() const {
-  return tmcl::SerialSettings{static_cast<uint8_t>(global_.serial_address),
-                              static_cast<uint8_t>(global_.serial_host_address),
-                              static_cast<uint8_t>(global_.telegram_pause_ms)};
-}
-
-// ROR/ROL write the target speed (AP 2) in the units of AP 255.
-Status Tmcm142::rotate(uint8_t motor, int32_t velocity) { return axis_parameters().write(*this, motor, 2, velocity); }
-
-Status Tmcm142::stop(uint8_t /*motor*/) {
-  axis_.stop();
-  return Status::kOk;
-}
-
-// MVP ABS/REL/COORD write the target position (AP 0). REL is relative to the actual position and
-// wraps at 32 bits like the position counter; COORD takes coordinate 0..20.
+// MVP COORD moves to coordinate 0..20 (a write of the target position, AP 0); ABS and REL are
+// the base's.
 Status Tmcm142::move(uint8_t motor, uint8_t move_type, int32_t value) {
-  switch (move_type) {
-    case tmcl::move_type::kAbsolute:
-      return axis_parameters().write(*this, motor, 0, value);
-    case tmcl::move_type::kRelative: {
-      const auto target = static_cast<int32_t>(static_cast<uint32_t>(axis_.actual_position()) + static_cast<uint32_t>(value));
-      return axis_parameters().write(*this, motor, 0, target);
-    }
-    case tmcl::move_type::kCoordinate:
-      if (value < 0 || value >= kCoordinateCount) return Status::kInvalidValue;
-      return axis_parameters().write(*this, motor, 0, coordinates_[static_cast<size_t>(value)]);
-    default:
-      return Status::kWrongType;
-  }
+  if (move_type != tmcl::move_type::kCoordinate) return TmclModule::move(motor, move_type, value);
+  if (value < 0 || value >= kCoordinateCount) return Status::kInvalidValue;
+  return move_to(motor, coordinates_[static_cast<size_t>(value)]);
 }
 
-bool Tmcm142::position_reached(uint8_t /*motor*/) const { return axis_.position_reached(); }
-
-bool Tmcm142::home_switch_active(uint8_t /*motor*/) const { return axis_.state.home_switch_active != 0; }
-
-bool Tmcm142::stop_switch_active(uint8_t /*motor*/, bool left) const {
-  return (left ? axis_.state.left_switch_active : axis_.state.right_switch_active) != 0;
-}
-
-bool Tmcm142::reference_search_running(uint8_t /*motor*/) const { return axis_.reference_search_running(); }
+bool Tmcm142::reference_search_running(uint8_t /*motor*/) const { return axis().reference_search_running(); }
 
 Status Tmcm142::reference_search(uint8_t motor, uint8_t type, int32_t& value) {
   if (motor >= kMotorCount) return Status::kInvalidValue;
   switch (type) {
     case kRfsStart:
       // A search at speed 0 would never end.
-      if (axis_.config.reference_fast_pps <= 0.0 || axis_.config.reference_slow_pps <= 0.0) return Status::kInvalidValue;
-      axis_.start_reference_search();
+      if (axis().config.reference_fast_pps <= 0.0 || axis().config.reference_slow_pps <= 0.0) return Status::kInvalidValue;
+      axis().start_reference_search();
       return Status::kOk;
     case kRfsStop:
-      axis_.stop_reference_search();
+      axis().stop_reference_search();
       return Status::kOk;
     case kRfsStatus:
-      value = axis_.reference_search_running() ? 1 : 0;
+      value = axis().reference_search_running() ? 1 : 0;
       return Status::kOk;
     default:
       return Status::kWrongType;
@@ -164,7 +108,7 @@ Status Tmcm142::set_coordinate(uint8_t number, uint8_t motor, int32_t position) 
     return Status::kOk;
   }
   if (motor >= kMotorCount) return Status::kInvalidValue;
-  const bool stored = global_.coordinate_storage == CoordinateStorage::kEeprom && number != 0;
+  const bool stored = global_config().coordinate_storage == CoordinateStorage::kEeprom && number != 0;
   if (stored && eeprom_locked_) return Status::kEepromLocked;
   const int32_t previous = coordinates_[number];
   coordinates_[number] = position;
@@ -195,34 +139,7 @@ Status Tmcm142::get_coordinate(uint8_t number, uint8_t motor, int32_t& position)
 // CCO n, 0: the actual position (AP 1) becomes coordinate n.
 Status Tmcm142::capture_coordinate(uint8_t number, uint8_t motor) {
   if (motor >= kMotorCount) return number >= kCoordinateCount ? Status::kWrongType : Status::kInvalidValue;
-  return set_coordinate(number, motor, axis_.actual_position());
-}
-
-Status Tmcm142::set_output(uint8_t port, uint8_t bank, int32_t value) {
-  if (bank != kIoBankDigitalOutputs) return Status::kInvalidValue;
-  if (port >= board::Tmcm142Io::kDigitalOutputCount) return Status::kWrongType;
-  if (value != 0 && value != 1) return Status::kInvalidValue;
-  io_.set_digital_output(port, value != 0);
-  return Status::kOk;
-}
-
-Status Tmcm142::get_input(uint8_t port, uint8_t bank, int32_t& value) {
-  switch (bank) {
-    case kIoBankDigitalInputs:
-      if (port >= board::Tmcm142Io::kDigitalInputCount) return Status::kWrongType;
-      value = io_.digital_input(port) ? 1 : 0;
-      return Status::kOk;
-    case kIoBankAnalogInputs:
-      if (port >= board::Tmcm142Io::kAnalogInputCount) return Status::kWrongType;
-      value = io_.analog_input(port);
-      return Status::kOk;
-    case kIoBankDigitalOutputs:
-      if (port >= board::Tmcm142Io::kDigitalOutputCount) return Status::kWrongType;
-      value = io_.digital_output(port) ? 1 : 0;
-      return Status::kOk;
-    default:
-      return Status::kInvalidValue;
-  }
+  return set_coordinate(number, motor, axis().actual_position());
 }
 
 }  // namespace motwin::modules::tmcm142

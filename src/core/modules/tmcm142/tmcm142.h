@@ -1,7 +1,8 @@
 // The TMCM-142 module profile (firmware 142V1.06): single-axis stepper with the TMC457 feature set
 // (S-ramps, up to 1024 microsteps, ABN encoder with easyPID, reference search, coordinates) and
-// the TMCL ASCII interface, behind the TmclDevice interface. Parameter numbers follow
-// notes/tmcm142.md; the ones Motwin had to number are marked in the tables (docs/tmcm-142.md).
+// the TMCL ASCII interface, on the TMCL module base (core/tmcl/tmcl_module.h). Parameter
+// numbers follow notes/tmcm142.md; the ones Motwin had to number are marked in the tables
+// (docs/tmcm-142.md).
 #pragma once
 
 #include <array>
@@ -20,6 +21,7 @@
 #include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
+#include "core/tmcl/tmcl_module.h"
 
 namespace motwin::modules::tmcm142 {
 
@@ -49,57 +51,42 @@ inline constexpr int32_t kEepromMagic = 228;          // GP 64 of a valid image
 inline constexpr int32_t kLockCode = 1234;            // GP 73
 inline constexpr int32_t kUnlockCode = 4321;
 
-class Tmcm142 final : public tmcl::ModuleStorage<Tmcm142> {
- public:
-  static constexpr std::string_view kName = "tmcm-142";
-  static constexpr tmcl::FirmwareIdentity kIdentity{142, 1, 6, "142V1.06"};
-  static constexpr uint8_t kMotorCount = 1;
-  static constexpr tmcl::NvmLayout kNvmLayout =
-      tmcl::make_nvm_layout(kMotorCount, kStorableUserVariables, kProgramCapacity, kCoordinateCount);
-  // Bumped whenever kNvmLayout or the meaning of a stored value changes.
-  static constexpr uint32_t kNvmLayoutVersion = 1;
+inline constexpr tmcl::ModuleFacts kFacts{
+    .name = "tmcm-142",
+    .identity = {142, 1, 6, "142V1.06"},
+    .nvm_layout = tmcl::make_nvm_layout(1, kStorableUserVariables, kProgramCapacity, kCoordinateCount),
+    .nvm_layout_version = 1,
+    .control_tick_us = kControlTickUs,
+    // ROR/ROL write the target speed (AP 2) in the units of AP 255, MVP the target position (AP 0).
+    .motion = {.target_position = 0, .target_velocity = 2},
+};
 
-  using Table = params::ParameterTable<Tmcm142>;
+// Runtime, tick timer, program memory, engine, I/O banks and the common motion commands come
+// from tmcl::TmclModule, the parameter commands, storage and power-up from tmcl::ModuleStorage;
+// the module adds its tables, the power stage, the EEPROM lock, the coordinates, the reference
+// search and GP 133.
+class Tmcm142 final : public tmcl::TmclModule<Tmcm142, Tmcm142Axis, GlobalConfig, board::Tmcm142Io, kFacts> {
+ public:
+  Tmcm142(board::NonVolatileMemory& nvm, board::StepperPowerStage& stage, board::Tmcm142Io& io)
+      : TmclModule(nvm, io), stage_(stage) {}
+
   static const Table& axis_parameters();
   static const Table& global_parameters();  // bank 0
   // format_factory_image(image, size): tmcl::ModuleStorage.
 
-  // Does not touch `nvm` beyond reading it: call engine().power_up() to start.
-  Tmcm142(board::NonVolatileMemory& nvm, board::StepperPowerStage& stage, board::Tmcm142Io& io);
-  Tmcm142(const Tmcm142&) = delete;
-  Tmcm142& operator=(const Tmcm142&) = delete;
-
-  tmcl::TmclEngine& engine() { return engine_; }
-
-  // One 50 µs control tick: the axis (feedback in, drive out), then at most one instruction of
-  // a running program. The board fills stage.feedback before and applies stage.drive after.
-  void tick();
-  uint64_t tick_count() const { return tick_count_; }
-  uint32_t tick_timer_ms() const { return tick_timer_ms_; }
-
-  Tmcm142Axis& axis() { return axis_; }
-  const Tmcm142Axis& axis() const { return axis_; }
-  GlobalConfig& global_config() { return global_; }
-  board::Tmcm142Io& io() { return io_; }
   board::StepperPowerStage& power_stage() { return stage_; }
   bool eeprom_locked() const { return eeprom_locked_; }
   int32_t coordinate(uint8_t number) const { return coordinates_[number]; }
 
-  // TmclDevice.
-  const tmcl::FirmwareIdentity& identity() const override { return kIdentity; }
-  uint8_t motor_count() const override { return kMotorCount; }
-  tmcl::SerialSettings serial_settings() const override;
-  tmcl::TmclRuntime& runtime() override { return runtime_; }
-  tmcl::Status rotate(uint8_t motor, int32_t velocity) override;
-  tmcl::Status stop(uint8_t motor) override;
+  // tmcl::TmclModule hook: one 50 µs control tick of the axis (feedback in, drive out). The
+  // board fills stage.feedback before and applies stage.drive after.
+  void tick_axis() {
+    axis().tick(stage_);
+    if (axis().take_deviation_event()) runtime().error_flags |= tmcl::kErrorDeviation;
+  }
+
+  // TmclDevice: what the TMCL module base does not answer, or answers differently.
   tmcl::Status move(uint8_t motor, uint8_t move_type, int32_t value) override;
-  bool position_reached(uint8_t motor) const override;
-  tmcl::Status set_output(uint8_t port, uint8_t bank, int32_t value) override;
-  tmcl::Status get_input(uint8_t port, uint8_t bank, int32_t& value) override;
-  tmcl::ProgramMemory* program_memory() override { return &program_; }
-  bool autostart() const override { return global_.auto_start_mode != 0; }
-  bool home_switch_active(uint8_t motor) const override;
-  bool stop_switch_active(uint8_t motor, bool left) const override;
   bool reference_search_running(uint8_t motor) const override;
   tmcl::Status reference_search(uint8_t motor, uint8_t type, int32_t& value) override;
   tmcl::Status set_coordinate(uint8_t number, uint8_t motor, int32_t position) override;
@@ -107,7 +94,6 @@ class Tmcm142 final : public tmcl::ModuleStorage<Tmcm142> {
   tmcl::Status capture_coordinate(uint8_t number, uint8_t motor) override;
 
   // Used by the table bindings.
-  void set_tick_timer_ms(uint32_t ms) { tick_timer_ms_ = ms; tick_fraction_ = 0; }
   // GP 73: 1234 locks, 4321 unlocks (stored at once, even while locked); other values status 4.
   tmcl::Status set_eeprom_lock(int32_t code);
   int32_t next_random();  // GP 133
@@ -116,27 +102,15 @@ class Tmcm142 final : public tmcl::ModuleStorage<Tmcm142> {
   void clear_ram_state();
   void before_axis_restore();
   void after_restore();
-  bool skip_user_variable_restore() const { return global_.skip_user_variable_restore != 0; }
 
  private:
   tmcl::Status store_coordinate(uint8_t number);
   void load_coordinate(uint8_t number);
 
   board::StepperPowerStage& stage_;
-  board::Tmcm142Io& io_;
-  Tmcm142Axis axis_;
-  GlobalConfig global_;
   bool eeprom_locked_ = false;
   std::array<int32_t, kCoordinateCount> coordinates_{};
   uint32_t random_state_ = 0x142142u;
-  tmcl::TmclRuntime runtime_;
-  uint64_t tick_count_ = 0;
-  uint32_t tick_timer_ms_ = 0;
-  uint32_t tick_fraction_ = 0;
-  std::array<uint8_t, kProgramCapacity * tmcl::kProgramRecordBytes> program_mirror_{};
-  tmcl::ProgramMemory program_{nvm_, kNvmLayout.program_offset, kProgramCapacity, program_mirror_.data()};
-  // Last: it refers to the members above.
-  tmcl::TmclEngine engine_{*this};
 };
 
 }  // namespace motwin::modules::tmcm142

@@ -199,7 +199,8 @@ constexpr Row kAxisRows[] = {
 
 // Bank 0. Section "Global parameters" of notes/tmcm142.md; every writable one below 128 is
 // automatically stored (A), as on the TMCM-1636 (docs/decisions.md). GP 73 stores itself.
-constexpr Row kGlobalRows[] = {
+// GP 128..132 come from the TMCL module base.
+constexpr Row kSettingRows[] = {
   {{64, "EEPROM magic", 0, 255, kEepromMagic, access("RWA"), Unit::kNone, "Any value other than 228 re-initialises all parameters at the next power-up"}, global_field<&GlobalConfig::eeprom_magic>()},
   {{65, "serial baud rate", 0, 11, 0, access("RWA"), Unit::kBaudRateCode, "0 9600, 1 14400, 2 19200, 3 28800, 4 38400, 5 57600, 6 76800, 7 115200, 8 230400, 9 250000, 10 500000, 11 1000000 bit/s; no effect on a pseudo-terminal"}, global_field<&GlobalConfig::serial_baud_rate_code>()},
   {{66, "serial address", 1, 255, 1, access("RWA"), Unit::kAddress, "Module (target) address"}, global_field<&GlobalConfig::serial_address>()},
@@ -215,22 +216,15 @@ constexpr Row kGlobalRows[] = {
   {{77, "auto start mode", 0, 1, 1, access("RWA"), Unit::kNone, "1 starts the TMCL program after power-up"}, global_field<&GlobalConfig::auto_start_mode>()},
   {{84, "coordinate storage", 0, 1, 0, access("RWA"), Unit::kNone, "0 coordinates in RAM (SCO/GCO n, 255 copy them), 1 coordinates 1..20 stored at once and restored at power-up"}, global_field<&GlobalConfig::coordinate_storage>()},
   {{85, "do not restore user variables", 0, 1, 0, access("RWA"), Unit::kNone, "0 user variables 0..55 restored at power-up, 1 they start at 0"}, global_field<&GlobalConfig::skip_user_variable_restore>()},
-  {{128, "application status", 0, 3, 0, access("R"), Unit::kNone, "0 stop, 1 run, 2 step, 3 reset"},
-   {[](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.runtime().application_status); }, nullptr}},
-  {{129, "download mode", 0, 1, 0, access("R"), Unit::kNone, "1 while the module is in download mode (command 132)"},
-   {[](Tmcm142& m, uint8_t) { return m.runtime().download_mode ? 1 : 0; }, nullptr}},
-  {{130, "program counter", 0, kMaxU32, 0, access("R"), Unit::kNone, "TMCL program counter"},
-   {[](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.runtime().program_counter); }, nullptr}},
-  {{132, "tick timer", 0, kMaxU32, 0, access("RW"), Unit::kMillisecond, "TMCL tick timer, milliseconds since power-up"},
-   {[](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.tick_timer_ms()); },
-    [](Tmcm142& m, uint8_t, int32_t value) {
-      m.set_tick_timer_ms(static_cast<uint32_t>(value));
-      return Status::kOk;
-    }}},
+};
+// GP 133 follows the base's GP 128..132.
+constexpr Row kRandomNumberRows[] = {
   {{133, "random number", 0, kMax32, 0, access("R"), Unit::kNone, "A new pseudo-random number 0..2^31-1 on every read (xorshift, reproducible)"},
    {[](Tmcm142& m, uint8_t) { return m.next_random(); }, nullptr}},
 };
 // clang-format on
+constexpr auto kGlobalRows =
+    params::join_rows<Tmcm142>(kSettingRows, Tmcm142::program_status_rows(), kRandomNumberRows);
 
 constexpr Tmcm142::Table kAxisTable{kAxisRows};
 constexpr Tmcm142::Table kGlobalTable{kGlobalRows};

@@ -199,6 +199,7 @@ class Tmcm1636Axis {
   void finish_restore() { restoring_ = false; }
 
   int32_t target_position() const { return ramp_.target_position(); }
+  int32_t actual_position() const { return state.actual_position; }
   int32_t ramp_position() const { return ramp_.position(); }
   bool position_reached() const { return state.position_reached != 0; }
   const motion::TrapezoidRamp& ramp() const { return ramp_; }

@@ -240,8 +240,9 @@ constexpr Row kAxisRows[] = {
 };
 
 // Bank 0 (table 13). Section 4.1: "parameters between 64 and 128 are automatically stored",
-// so every writable one below 128 carries A. GP 66/76 defaults: DESIGN.md errata.
-constexpr Row kGlobalRows[] = {
+// so every writable one below 128 carries A. GP 66/76 defaults: DESIGN.md errata. GP 128..132
+// come from the TMCL module base.
+constexpr Row kSettingRows[] = {
   {{65, "serial baud rate", 0, 7, 7, access("RWA"), Unit::kBaudRateCode, "0 9600, 1 14400, 2 19200, 3 28800, 4 38400, 5 57600, 6 76800, 7 115200 bit/s; no effect on a pseudo-terminal"}, global_field<&GlobalConfig::serial_baud_rate_code>()},
   {{66, "serial address", 1, 255, 1, access("RWAX"), Unit::kAddress, "Module (target) address on RS485, RS232, USB and TCP"}, global_field<&GlobalConfig::serial_address>()},
   // Motwin extension: the TMCM-1636 manual has no ASCII interface; Motwin gives it the one of
@@ -256,20 +257,9 @@ constexpr Row kGlobalRows[] = {
   {{77, "auto start mode", 0, 1, 1, access("RWAX"), Unit::kNone, "1 starts the TMCL program after power-up"}, global_field<&GlobalConfig::auto_start_mode>()},
   // Not in table 13, but manual 6.4 describes it.
   {{85, "do not restore user variables", 0, 1, 0, access("RWA"), Unit::kNone, "0 user variables 0..55 restored at power-up, 1 they start at 0"}, global_field<&GlobalConfig::skip_user_variable_restore>()},
-  {{128, "application status", 0, 3, 0, access("R"), Unit::kNone, "0 stop, 1 run, 2 step, 3 reset"},
-   {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.runtime().application_status); }, nullptr}},
-  {{129, "download mode", 0, 1, 0, access("R"), Unit::kNone, "1 while the module is in download mode (command 132)"},
-   {[](Tmcm1636& m, uint8_t) { return m.runtime().download_mode ? 1 : 0; }, nullptr}},
-  {{130, "program counter", 0, kMaxU32, 0, access("R"), Unit::kNone, "TMCL program counter"},
-   {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.runtime().program_counter); }, nullptr}},
-  {{132, "tick timer", 0, kMaxU32, 0, access("RW"), Unit::kMillisecond, "TMCL tick timer, milliseconds since power-up"},
-   {[](Tmcm1636& m, uint8_t) { return static_cast<int32_t>(m.tick_timer_ms()); },
-    [](Tmcm1636& m, uint8_t, int32_t value) {
-      m.set_tick_timer_ms(static_cast<uint32_t>(value));
-      return Status::kOk;
-    }}},
 };
 // clang-format on
+constexpr auto kGlobalRows = params::join_rows<Tmcm1636>(kSettingRows, Tmcm1636::program_status_rows());
 
 constexpr Tmcm1636::Table kAxisTable{kAxisRows};
 constexpr Tmcm1636::Table kGlobalTable{kGlobalRows};
