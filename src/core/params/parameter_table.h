@@ -22,7 +22,7 @@ class ParameterTable {
 
   constexpr std::span<const Row> rows() const { return rows_; }
 
-  // Rows are sorted by number (checked by is_sorted() in each module's static_assert).
+  // Rows are sorted by number (each module builds its tables with sorted_table()).
   constexpr const Row* find(uint16_t number) const {
     size_t lo = 0;
     size_t hi = rows_.size();
@@ -69,6 +69,18 @@ class ParameterTable {
  private:
   std::span<const Row> rows_;
 };
+
+// Deliberately not constexpr: reaching it during constant evaluation is a compile error.
+void parameter_rows_not_sorted_by_number();
+
+// A table over rows with static storage, checked at compile time to be sorted by number (find()
+// bisects): `static constexpr Table kTable = sorted_table<Owner>(kRows);`.
+template <class Owner>
+consteval ParameterTable<Owner> sorted_table(std::span<const ParameterRow<Owner>> rows) {
+  const ParameterTable<Owner> table{rows};
+  if (!table.is_sorted()) parameter_rows_not_sorted_by_number();
+  return table;
+}
 
 namespace detail {
 template <class Rows>

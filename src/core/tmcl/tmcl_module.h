@@ -8,7 +8,8 @@
 // and answers the commands that are the same on these modules: ROR/ROL/MST and MVP ABS/REL
 // through the axis parameter table, SIO/GIO over the three I/O banks, the serial settings and
 // autostart from the bank-0 settings, the switch conditions of WAIT and the interrupts, and
-// GP 128..132 (program_status_rows(), listed in each module's bank-0 table).
+// GP 128..132 (program_status_rows(), listed in each module's bank-0 table). The helpers its
+// parameter tables are written with come from module_rows.h.
 //
 // A CRTP base. The module passes its parts' types and its ModuleFacts (name, identity, EEPROM
 // layout, tick period, motion parameters); besides what ModuleStorage asks for (its tables),
@@ -36,6 +37,7 @@
 #include "core/tmcl/device.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/instruction.h"
+#include "core/tmcl/module_rows.h"
 #include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
@@ -68,7 +70,7 @@ inline constexpr uint8_t kDigitalOutputs = 2;
 }  // namespace io_bank
 
 template <class Derived, class Axis, class Globals, class Io, ModuleFacts kFacts>
-class TmclModule : public ModuleStorage<Derived> {
+class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axis, Globals> {
  public:
   static constexpr std::string_view kName = kFacts.name;
   static constexpr FirmwareIdentity kIdentity = kFacts.identity;

@@ -11,30 +11,14 @@ namespace {
 
 using params::access;
 using params::Binding;
-using params::ParameterRow;
 using params::Unit;
 using tmcl::Status;
-using Row = ParameterRow<Tmcm142>;
 
-constexpr int64_t kMin32 = INT32_MIN;
-constexpr int64_t kMax32 = INT32_MAX;
-constexpr int64_t kMaxU32 = UINT32_MAX;
-
-AxisConfig& axis_config(Tmcm142& m) { return m.axis().config; }
 motion::EasyPidConfig& pid_config(Tmcm142& m) { return m.axis().config.pid; }
-GlobalConfig& global_config(Tmcm142& m) { return m.global_config(); }
 
-template <auto Field>
-constexpr Binding<Tmcm142> config_field() {
-  return params::field_binding<Tmcm142, axis_config, Field>();
-}
 template <int32_t motion::EasyPidConfig::*Field>
 constexpr Binding<Tmcm142> pid_field() {
   return params::field_binding<Tmcm142, pid_config, Field>();
-}
-template <auto Field>
-constexpr Binding<Tmcm142> global_field() {
-  return params::field_binding<Tmcm142, global_config, Field>();
 }
 
 int32_t clamp_to_int32(double v) {
@@ -88,27 +72,6 @@ constexpr Binding<Tmcm142> acceleration_field() {
           }};
 }
 
-template <int kIndex>
-constexpr Binding<Tmcm142> bow_field() {
-  return {[](Tmcm142& m, uint8_t) { return m.axis().config.bow[kIndex]; },
-          [](Tmcm142& m, uint8_t, int32_t value) {
-            m.axis().config.bow[kIndex] = value;
-            return Status::kOk;
-          }};
-}
-
-constexpr Binding<Tmcm142> kTargetPosition{
-    [](Tmcm142& m, uint8_t) { return m.axis().target_position(); },
-    [](Tmcm142& m, uint8_t, int32_t value) {
-      m.axis().set_target_position(value);
-      return Status::kOk;
-    }};
-constexpr Binding<Tmcm142> kActualPosition{
-    [](Tmcm142& m, uint8_t) { return m.axis().actual_position(); },
-    [](Tmcm142& m, uint8_t, int32_t value) {
-      m.axis().set_actual_position(value);
-      return Status::kOk;
-    }};
 constexpr Binding<Tmcm142> kTargetSpeed{
     [](Tmcm142& m, uint8_t) { return speed_to_wire(m, m.axis().state.target_velocity_pps); },
     [](Tmcm142& m, uint8_t, int32_t value) {
@@ -119,10 +82,6 @@ constexpr Binding<Tmcm142> kTargetSpeed{
     }};
 constexpr Binding<Tmcm142> kActualSpeed{
     [](Tmcm142& m, uint8_t) { return speed_to_wire(m, m.axis().actual_velocity_pps()); }, nullptr};
-constexpr Binding<Tmcm142> kPositionReached{
-    [](Tmcm142& m, uint8_t) { return m.axis().position_reached() ? 1 : 0; }, nullptr};
-constexpr Binding<Tmcm142> kRightSwitch{[](Tmcm142& m, uint8_t) { return m.axis().state.right_switch_active; }, nullptr};
-constexpr Binding<Tmcm142> kLeftSwitch{[](Tmcm142& m, uint8_t) { return m.axis().state.left_switch_active; }, nullptr};
 constexpr Binding<Tmcm142> kPidErrorSum{
     [](Tmcm142& m, uint8_t) { return clamp_to_int32(static_cast<double>(m.axis().pid_state().error_sum)); },
     [](Tmcm142& m, uint8_t, int32_t) {
@@ -130,110 +89,100 @@ constexpr Binding<Tmcm142> kPidErrorSum{
       return Status::kOk;
     }};
 constexpr Binding<Tmcm142> kPidError{[](Tmcm142& m, uint8_t) { return m.axis().pid_state().error; }, nullptr};
-constexpr Binding<Tmcm142> kPidVelocity{
-    [](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.axis().pid_velocity_internal()); }, nullptr};
-constexpr Binding<Tmcm142> kEncoderPosition{
-    [](Tmcm142& m, uint8_t) { return m.axis().state.encoder_position; },
-    [](Tmcm142& m, uint8_t, int32_t value) {
-      m.axis().set_encoder_position(value);
-      return Status::kOk;
-    }};
 constexpr Binding<Tmcm142> kRampMode{
     [](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.axis().ramp_mode()); },
     [](Tmcm142& m, uint8_t, int32_t value) {
       return m.axis().set_ramp_mode(value) == 0 ? Status::kOk : Status::kInvalidValue;
     }};
-constexpr Binding<Tmcm142> kStatusFlags{[](Tmcm142& m, uint8_t) { return m.axis().status_flags(); }, nullptr};
-constexpr Binding<Tmcm142> kVelocityReached{
-    [](Tmcm142& m, uint8_t) { return m.axis().velocity_reached() ? 1 : 0; }, nullptr};
-constexpr Binding<Tmcm142> kTravel{[](Tmcm142& m, uint8_t) { return m.axis().state.travel; }, nullptr};
-constexpr Binding<Tmcm142> kErrorFlags{[](Tmcm142& m, uint8_t) { return m.axis().take_error_flags(); }, nullptr};
 
-// clang-format off
-constexpr Row kAxisRows[] = {
-  {{0, "target position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Target position; writing it starts a move in position mode (as MVP ABS)"}, kTargetPosition},
-  {{1, "actual position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Position counter of the ramp generator; writing it sets the counter without moving"}, kActualPosition},
-  {{2, "target speed", -kMax32, kMax32, 0, access("RW"), Unit::kSpeed, "Target velocity of velocity mode (ROR/ROL); unit mode 1 limits it to +-31999999"}, kTargetSpeed},
-  {{3, "actual speed", -kMax32, kMax32, 0, access("R"), Unit::kSpeed, "Velocity of the ramp generator"}, kActualSpeed},
-  {{4, "max positioning speed", 0, kMax32, kDefaultMaxVelocity, access("RWE"), Unit::kSpeed, "VMAX; unit mode 1: 0..31999999 µsteps/s"}, speed_field<&AxisConfig::max_velocity_pps>()},
-  {{5, "max acceleration", 1, kMaxAccelerationInternal, kDefaultAcceleration, access("RWE"), Unit::kAcceleration, "AMAX, also the deceleration of positioning"}, acceleration_field<&AxisConfig::acceleration_pps2>()},
-  {{6, "max current", 0, 15, 5, access("RWE"), Unit::kNone, "Run current: (value + 1) * 7000 / 16 mA peak"}, config_field<&AxisConfig::run_current_code>()},
-  {{7, "standby current", 0, 15, 1, access("RWE"), Unit::kNone, "Current at rest after the standby delay (AP 214): (value + 1) * 7000 / 16 mA peak"}, config_field<&AxisConfig::standby_current_code>()},
-  {{8, "position reached", 0, 1, 0, access("R"), Unit::kNone, "1 in position mode at rest exactly on the target"}, kPositionReached},
-  {{10, "right limit switch state", 0, 1, 0, access("R"), Unit::kNone, "1 while the right limit switch is active (after AP 14 polarity and swap)"}, kRightSwitch},
-  {{11, "left limit switch state", 0, 1, 0, access("R"), Unit::kNone, "1 while the left limit switch is active"}, kLeftSwitch},
-  {{12, "right limit switch disable", 0, 1, 0, access("RWE"), Unit::kNone, "1: the right switch does not stop the motor"}, config_field<&AxisConfig::right_switch_disable>()},
-  {{13, "left limit switch disable", 0, 1, 0, access("RWE"), Unit::kNone, "1: the left switch does not stop the motor"}, config_field<&AxisConfig::left_switch_disable>()},
-  {{14, "switch mode", 0, 63, 0, access("RWE"), Unit::kNone, "[Motwin decision] bit 2 invert left, bit 3 invert right, bit 4 swap left/right, bits 0, 1 unused; bit 5 (public) soft stop with AP 15, else hard stop"}, config_field<&AxisConfig::switch_mode>()},
-  {{15, "stop deceleration", 1, kMaxAccelerationInternal, kDefaultAcceleration, access("RWE"), Unit::kAcceleration, "Deceleration of a soft stop at a limit switch"}, acceleration_field<&AxisConfig::stop_deceleration_pps2>()},
-  {{16, "bow 1", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk building up the acceleration, b * fCLK^3 / 2^64 µsteps/s^3; 16777215 = unlimited (trapezoid corner)"}, bow_field<0>()},
-  {{17, "bow 2", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk reducing the acceleration on reaching VMAX"}, bow_field<1>()},
-  {{18, "bow 3", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk building up the deceleration"}, bow_field<2>()},
-  {{19, "bow 4", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk reducing the deceleration at the end"}, bow_field<3>()},
-  {{27, "microstep resolution", kFinestResolutionCode, kCoarsestResolutionCode, kFinestResolutionCode, access("RWE"), Unit::kNone, "2^(11 - value) microsteps per full step: 1 = 1024 ... 11 = full steps; 0 (2048) refused"}, config_field<&AxisConfig::microstep_code>()},
-  {{30, "PID p factor", 0, 16777215, 65536, access("RWE"), Unit::kNone, "[Motwin decision] easyPID P: -pid_e * P / 256"}, pid_field<&motion::EasyPidConfig::p>()},
-  {{31, "PID i factor", 0, 16777215, 0, access("RWE"), Unit::kNone, "[Motwin decision] easyPID I: -pid_isum * I / 65536"}, pid_field<&motion::EasyPidConfig::i>()},
-  {{32, "PID d factor", 0, 16777215, 0, access("RWE"), Unit::kNone, "easyPID D: (last pid_e - pid_e, clipped to +-127) * D"}, pid_field<&motion::EasyPidConfig::d>()},
-  {{33, "PID i clipping", 0, 32640, 0, access("RWE"), Unit::kNone, "pid_isum clipped to +-value * 2^16"}, pid_field<&motion::EasyPidConfig::i_clip>()},
-  {{34, "PID i sum", kMin32, kMax32, 0, access("RW"), Unit::kNone, "Integrator sum (fCLK/128 samples); any write clears it"}, kPidErrorSum},
-  {{35, "PID d clock divider", 0, 255, 0, access("RWE"), Unit::kNone, "D sampled every value * 128 clocks (0 = 256)"}, pid_field<&motion::EasyPidConfig::d_clock_divider>()},
-  {{37, "PID dv clipping", 0, kMax32, 67108864, access("RWE"), Unit::kTmc457Velocity, "Limit of the velocity correction"}, pid_field<&motion::EasyPidConfig::velocity_clip>()},
-  {{38, "PID error", -(1 << 23), 1 << 23, 0, access("R"), Unit::kMicrosteps, "pid_e = encoder position - actual position, clipped to +-2^23"}, kPidError},
-  {{39, "PID vactual", kMin32, kMax32, 0, access("R"), Unit::kTmc457Velocity, "Ramp velocity plus the easyPID correction"}, kPidVelocity},
-  {{40, "PID mode", 0, 1, 0, access("RWE"), Unit::kNone, "0 open loop, 1 easyPID on the encoder"}, config_field<&AxisConfig::pid_mode>()},
-  {{41, "encoder position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Encoder counter scaled by AP 42; writing sets it"}, kEncoderPosition},
-  {{42, "encoder constant", 0, kMax32, 3355443, access("RWE"), Unit::kNone, "Microsteps per encoder count * 65536 (default 51.2: 4000 counts/rev at 1024 microsteps)"}, config_field<&AxisConfig::encoder_constant>()},
-  {{46, "encoder direction", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] 1 counts the encoder the other way"}, config_field<&AxisConfig::encoder_direction>()},
-  {{128, "ramp mode", 0, 3, 0, access("RW"), Unit::kNone, "0 position, 2 velocity, 3 hold (1 refused)"}, kRampMode},
-  {{129, "status flags", 0, 15, 0, access("R"), Unit::kNone, "Bit 0 position reached, 1 velocity reached, 2 velocity zero, 3 encoder deviation exceeded"}, kStatusFlags},
-  {{130, "velocity reached", 0, 1, 0, access("R"), Unit::kNone, "1 when the actual speed equals the target speed"}, kVelocityReached},
-  {{193, "reference search mode", 1, 3, 1, access("RWE"), Unit::kNone, "1 left switch, 2 right then left switch, 3 as 2 with the reference at the centre of the left switch"}, config_field<&AxisConfig::reference_mode>()},
-  {{194, "reference search speed", 0, kMax32, kDefaultMaxVelocity, access("RWE"), Unit::kSpeed, "Fast approach of the switches"}, speed_field<&AxisConfig::reference_fast_pps>()},
-  {{195, "reference switch speed", 0, kMax32, kDefaultReferenceSlow, access("RWE"), Unit::kSpeed, "Slow search of the switching points (default a quarter of AP 4)"}, speed_field<&AxisConfig::reference_slow_pps>()},
-  {{196, "end switch distance", kMin32, kMax32, 0, access("R"), Unit::kMicrosteps, "Right minus left switching point, measured by modes 2 and 3"}, kTravel},
-  {{207, "error flags", 0, 3, 0, access("R"), Unit::kNone, "Bit 1 stopped by encoder deviation (bit 0 is never set by Motwin); cleared by reading"}, kErrorFlags},
-  {{212, "max encoder deviation", 0, kMax32, 0, access("RWE"), Unit::kMicrosteps, "|encoder - actual position| above it stops the motor and sets EDV; 0 off"}, config_field<&AxisConfig::max_encoder_deviation>()},
-  {{214, "standby delay", 0, 65535, 200, access("RWE"), Unit::kTenMilliseconds, "[Motwin decision] time at rest before the standby current (AP 7)"}, config_field<&AxisConfig::standby_delay_10ms>()},
-  {{255, "unit mode", 0, 1, 0, access("RWE"), Unit::kNone, "Speeds and accelerations: 0 TMC457 units, 1 µsteps/s and µsteps/s²"}, config_field<&AxisConfig::unit_mode>()},
-};
+}  // namespace
+
+// The bindings (config_field, state_value, axis_command ...) are those of tmcl::ModuleRows
+// (core/tmcl/module_rows.h).
+const Tmcm142::Table& Tmcm142::axis_parameters() {
+  // clang-format off
+  static constexpr Row kRows[] = {
+    {{0, "target position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Target position; writing it starts a move in position mode (as MVP ABS)"}, axis_command<&Tmcm142Axis::target_position, &Tmcm142Axis::set_target_position>()},
+    {{1, "actual position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Position counter of the ramp generator; writing it sets the counter without moving"}, axis_command<&Tmcm142Axis::actual_position, &Tmcm142Axis::set_actual_position>()},
+    {{2, "target speed", -kMax32, kMax32, 0, access("RW"), Unit::kSpeed, "Target velocity of velocity mode (ROR/ROL); unit mode 1 limits it to +-31999999"}, kTargetSpeed},
+    {{3, "actual speed", -kMax32, kMax32, 0, access("R"), Unit::kSpeed, "Velocity of the ramp generator"}, kActualSpeed},
+    {{4, "max positioning speed", 0, kMax32, kDefaultMaxVelocity, access("RWE"), Unit::kSpeed, "VMAX; unit mode 1: 0..31999999 µsteps/s"}, speed_field<&AxisConfig::max_velocity_pps>()},
+    {{5, "max acceleration", 1, kMaxAccelerationInternal, kDefaultAcceleration, access("RWE"), Unit::kAcceleration, "AMAX, also the deceleration of positioning"}, acceleration_field<&AxisConfig::acceleration_pps2>()},
+    {{6, "max current", 0, 15, 5, access("RWE"), Unit::kNone, "Run current: (value + 1) * 7000 / 16 mA peak"}, config_field<&AxisConfig::run_current_code>()},
+    {{7, "standby current", 0, 15, 1, access("RWE"), Unit::kNone, "Current at rest after the standby delay (AP 214): (value + 1) * 7000 / 16 mA peak"}, config_field<&AxisConfig::standby_current_code>()},
+    {{8, "position reached", 0, 1, 0, access("R"), Unit::kNone, "1 in position mode at rest exactly on the target"}, axis_value<&Tmcm142Axis::position_reached>()},
+    {{10, "right limit switch state", 0, 1, 0, access("R"), Unit::kNone, "1 while the right limit switch is active (after AP 14 polarity and swap)"}, state_value<&AxisState::right_switch_active>()},
+    {{11, "left limit switch state", 0, 1, 0, access("R"), Unit::kNone, "1 while the left limit switch is active"}, state_value<&AxisState::left_switch_active>()},
+    {{12, "right limit switch disable", 0, 1, 0, access("RWE"), Unit::kNone, "1: the right switch does not stop the motor"}, config_field<&AxisConfig::right_switch_disable>()},
+    {{13, "left limit switch disable", 0, 1, 0, access("RWE"), Unit::kNone, "1: the left switch does not stop the motor"}, config_field<&AxisConfig::left_switch_disable>()},
+    {{14, "switch mode", 0, 63, 0, access("RWE"), Unit::kNone, "[Motwin decision] bit 2 invert left, bit 3 invert right, bit 4 swap left/right, bits 0, 1 unused; bit 5 (public) soft stop with AP 15, else hard stop"}, config_field<&AxisConfig::switch_mode>()},
+    {{15, "stop deceleration", 1, kMaxAccelerationInternal, kDefaultAcceleration, access("RWE"), Unit::kAcceleration, "Deceleration of a soft stop at a limit switch"}, acceleration_field<&AxisConfig::stop_deceleration_pps2>()},
+    {{16, "bow 1", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk building up the acceleration, b * fCLK^3 / 2^64 µsteps/s^3; 16777215 = unlimited (trapezoid corner)"}, element_field<&AxisConfig::bow, 0>()},
+    {{17, "bow 2", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk reducing the acceleration on reaching VMAX"}, element_field<&AxisConfig::bow, 1>()},
+    {{18, "bow 3", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk building up the deceleration"}, element_field<&AxisConfig::bow, 2>()},
+    {{19, "bow 4", 1, kMaxBow, kDefaultBow, access("RWE"), Unit::kNone, "[Motwin decision] jerk reducing the deceleration at the end"}, element_field<&AxisConfig::bow, 3>()},
+    {{27, "microstep resolution", kFinestResolutionCode, kCoarsestResolutionCode, kFinestResolutionCode, access("RWE"), Unit::kNone, "2^(11 - value) microsteps per full step: 1 = 1024 ... 11 = full steps; 0 (2048) refused"}, config_field<&AxisConfig::microstep_code>()},
+    {{30, "PID p factor", 0, 16777215, 65536, access("RWE"), Unit::kNone, "[Motwin decision] easyPID P: -pid_e * P / 256"}, pid_field<&motion::EasyPidConfig::p>()},
+    {{31, "PID i factor", 0, 16777215, 0, access("RWE"), Unit::kNone, "[Motwin decision] easyPID I: -pid_isum * I / 65536"}, pid_field<&motion::EasyPidConfig::i>()},
+    {{32, "PID d factor", 0, 16777215, 0, access("RWE"), Unit::kNone, "easyPID D: (last pid_e - pid_e, clipped to +-127) * D"}, pid_field<&motion::EasyPidConfig::d>()},
+    {{33, "PID i clipping", 0, 32640, 0, access("RWE"), Unit::kNone, "pid_isum clipped to +-value * 2^16"}, pid_field<&motion::EasyPidConfig::i_clip>()},
+    {{34, "PID i sum", kMin32, kMax32, 0, access("RW"), Unit::kNone, "Integrator sum (fCLK/128 samples); any write clears it"}, kPidErrorSum},
+    {{35, "PID d clock divider", 0, 255, 0, access("RWE"), Unit::kNone, "D sampled every value * 128 clocks (0 = 256)"}, pid_field<&motion::EasyPidConfig::d_clock_divider>()},
+    {{37, "PID dv clipping", 0, kMax32, 67108864, access("RWE"), Unit::kTmc457Velocity, "Limit of the velocity correction"}, pid_field<&motion::EasyPidConfig::velocity_clip>()},
+    {{38, "PID error", -(1 << 23), 1 << 23, 0, access("R"), Unit::kMicrosteps, "pid_e = encoder position - actual position, clipped to +-2^23"}, kPidError},
+    {{39, "PID vactual", kMin32, kMax32, 0, access("R"), Unit::kTmc457Velocity, "Ramp velocity plus the easyPID correction"}, axis_value<&Tmcm142Axis::pid_velocity_internal>()},
+    {{40, "PID mode", 0, 1, 0, access("RWE"), Unit::kNone, "0 open loop, 1 easyPID on the encoder"}, config_field<&AxisConfig::pid_mode>()},
+    {{41, "encoder position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Encoder counter scaled by AP 42; writing sets it"}, axis_command<&AxisState::encoder_position, &Tmcm142Axis::set_encoder_position>()},
+    {{42, "encoder constant", 0, kMax32, 3355443, access("RWE"), Unit::kNone, "Microsteps per encoder count * 65536 (default 51.2: 4000 counts/rev at 1024 microsteps)"}, config_field<&AxisConfig::encoder_constant>()},
+    {{46, "encoder direction", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] 1 counts the encoder the other way"}, config_field<&AxisConfig::encoder_direction>()},
+    {{128, "ramp mode", 0, 3, 0, access("RW"), Unit::kNone, "0 position, 2 velocity, 3 hold (1 refused)"}, kRampMode},
+    {{129, "status flags", 0, 15, 0, access("R"), Unit::kNone, "Bit 0 position reached, 1 velocity reached, 2 velocity zero, 3 encoder deviation exceeded"}, axis_value<&Tmcm142Axis::status_flags>()},
+    {{130, "velocity reached", 0, 1, 0, access("R"), Unit::kNone, "1 when the actual speed equals the target speed"}, axis_value<&Tmcm142Axis::velocity_reached>()},
+    {{193, "reference search mode", 1, 3, 1, access("RWE"), Unit::kNone, "1 left switch, 2 right then left switch, 3 as 2 with the reference at the centre of the left switch"}, config_field<&AxisConfig::reference_mode>()},
+    {{194, "reference search speed", 0, kMax32, kDefaultMaxVelocity, access("RWE"), Unit::kSpeed, "Fast approach of the switches"}, speed_field<&AxisConfig::reference_fast_pps>()},
+    {{195, "reference switch speed", 0, kMax32, kDefaultReferenceSlow, access("RWE"), Unit::kSpeed, "Slow search of the switching points (default a quarter of AP 4)"}, speed_field<&AxisConfig::reference_slow_pps>()},
+    {{196, "end switch distance", kMin32, kMax32, 0, access("R"), Unit::kMicrosteps, "Right minus left switching point, measured by modes 2 and 3"}, state_value<&AxisState::travel>()},
+    {{207, "error flags", 0, 3, 0, access("R"), Unit::kNone, "Bit 1 stopped by encoder deviation (bit 0 is never set by Motwin); cleared by reading"}, axis_value<&Tmcm142Axis::take_error_flags>()},
+    {{212, "max encoder deviation", 0, kMax32, 0, access("RWE"), Unit::kMicrosteps, "|encoder - actual position| above it stops the motor and sets EDV; 0 off"}, config_field<&AxisConfig::max_encoder_deviation>()},
+    {{214, "standby delay", 0, 65535, 200, access("RWE"), Unit::kTenMilliseconds, "[Motwin decision] time at rest before the standby current (AP 7)"}, config_field<&AxisConfig::standby_delay_10ms>()},
+    {{255, "unit mode", 0, 1, 0, access("RWE"), Unit::kNone, "Speeds and accelerations: 0 TMC457 units, 1 µsteps/s and µsteps/s²"}, config_field<&AxisConfig::unit_mode>()},
+  };
+  // clang-format on
+  static constexpr Table kTable = params::sorted_table<Tmcm142>(kRows);
+  return kTable;
+}
 
 // Bank 0. Section "Global parameters" of notes/tmcm142.md; every writable one below 128 is
 // automatically stored (A), as on the TMCM-1636 (docs/decisions.md). GP 73 stores itself.
 // GP 128..132 come from the TMCL module base.
-constexpr Row kSettingRows[] = {
-  {{64, "EEPROM magic", 0, 255, kEepromMagic, access("RWA"), Unit::kNone, "Any value other than 228 re-initialises all parameters at the next power-up"}, global_field<&GlobalConfig::eeprom_magic>()},
-  {{65, "serial baud rate", 0, 11, 0, access("RWA"), Unit::kBaudRateCode, "0 9600, 1 14400, 2 19200, 3 28800, 4 38400, 5 57600, 6 76800, 7 115200, 8 230400, 9 250000, 10 500000, 11 1000000 bit/s; no effect on a pseudo-terminal"}, global_field<&GlobalConfig::serial_baud_rate_code>()},
-  {{66, "serial address", 1, 255, 1, access("RWA"), Unit::kAddress, "Module (target) address"}, global_field<&GlobalConfig::serial_address>()},
-  {{67, "ASCII mode", 0, 255, 0, access("RWA"), Unit::kNone, "Bit 0 start in ASCII mode; bits 4-5 echo: 00 each character, bit 4 whole line after CR, bit 5 none"}, global_field<&GlobalConfig::ascii_mode>()},
-  {{69, "CAN bit rate", 2, 8, 8, access("RWA"), Unit::kBitRateCode, "2 20, 3 50, 4 100, 5 125, 6 250, 7 500, 8 1000 kbit/s"}, global_field<&GlobalConfig::can_bit_rate_code>()},
-  {{70, "CAN reply ID", 0, 2047, 2, access("RWA"), Unit::kAddress, "CAN identifier of the module's replies"}, global_field<&GlobalConfig::can_reply_id>()},
-  {{71, "CAN ID", 0, 2047, 1, access("RWA"), Unit::kAddress, "CAN identifier the module listens to"}, global_field<&GlobalConfig::can_id>()},
-  {{73, "EEPROM lock", 0, kUnlockCode, 0, access("RW"), Unit::kNone, "Write 1234 to lock, 4321 to unlock (kept over power-up); reads 1 while locked. Locked: STAP, STGP, stored SGP and stored coordinates answer status 5"},
-   {[](Tmcm142& m, uint8_t) { return m.eeprom_locked() ? 1 : 0; },
-    [](Tmcm142& m, uint8_t, int32_t value) { return m.set_eeprom_lock(value); }}},
-  {{75, "telegram pause time", 0, 255, 0, access("RWA"), Unit::kMillisecond, "Pause before a serial reply is sent"}, global_field<&GlobalConfig::telegram_pause_ms>()},
-  {{76, "serial host address", 1, 255, 2, access("RWA"), Unit::kAddress, "Host address used in replies"}, global_field<&GlobalConfig::serial_host_address>()},
-  {{77, "auto start mode", 0, 1, 1, access("RWA"), Unit::kNone, "1 starts the TMCL program after power-up"}, global_field<&GlobalConfig::auto_start_mode>()},
-  {{84, "coordinate storage", 0, 1, 0, access("RWA"), Unit::kNone, "0 coordinates in RAM (SCO/GCO n, 255 copy them), 1 coordinates 1..20 stored at once and restored at power-up"}, global_field<&GlobalConfig::coordinate_storage>()},
-  {{85, "do not restore user variables", 0, 1, 0, access("RWA"), Unit::kNone, "0 user variables 0..55 restored at power-up, 1 they start at 0"}, global_field<&GlobalConfig::skip_user_variable_restore>()},
-};
-// GP 133 follows the base's GP 128..132.
-constexpr Row kRandomNumberRows[] = {
-  {{133, "random number", 0, kMax32, 0, access("R"), Unit::kNone, "A new pseudo-random number 0..2^31-1 on every read (xorshift, reproducible)"},
-   {[](Tmcm142& m, uint8_t) { return m.next_random(); }, nullptr}},
-};
-// clang-format on
-constexpr auto kGlobalRows =
-    params::join_rows<Tmcm142>(kSettingRows, Tmcm142::program_status_rows(), kRandomNumberRows);
-
-constexpr Tmcm142::Table kAxisTable{kAxisRows};
-constexpr Tmcm142::Table kGlobalTable{kGlobalRows};
-static_assert(kAxisTable.is_sorted(), "axis parameter rows must be sorted by number");
-static_assert(kGlobalTable.is_sorted(), "global parameter rows must be sorted by number");
-
-}  // namespace
-
-const Tmcm142::Table& Tmcm142::axis_parameters() { return kAxisTable; }
-const Tmcm142::Table& Tmcm142::global_parameters() { return kGlobalTable; }
+const Tmcm142::Table& Tmcm142::global_parameters() {
+  // clang-format off
+  static constexpr Row kSettingRows[] = {
+    {{64, "EEPROM magic", 0, 255, kEepromMagic, access("RWA"), Unit::kNone, "Any value other than 228 re-initialises all parameters at the next power-up"}, global_field<&GlobalConfig::eeprom_magic>()},
+    {{65, "serial baud rate", 0, 11, 0, access("RWA"), Unit::kBaudRateCode, "0 9600, 1 14400, 2 19200, 3 28800, 4 38400, 5 57600, 6 76800, 7 115200, 8 230400, 9 250000, 10 500000, 11 1000000 bit/s; no effect on a pseudo-terminal"}, global_field<&GlobalConfig::serial_baud_rate_code>()},
+    {{66, "serial address", 1, 255, 1, access("RWA"), Unit::kAddress, "Module (target) address"}, global_field<&GlobalConfig::serial_address>()},
+    {{67, "ASCII mode", 0, 255, 0, access("RWA"), Unit::kNone, "Bit 0 start in ASCII mode; bits 4-5 echo: 00 each character, bit 4 whole line after CR, bit 5 none"}, global_field<&GlobalConfig::ascii_mode>()},
+    {{69, "CAN bit rate", 2, 8, 8, access("RWA"), Unit::kBitRateCode, "2 20, 3 50, 4 100, 5 125, 6 250, 7 500, 8 1000 kbit/s"}, global_field<&GlobalConfig::can_bit_rate_code>()},
+    {{70, "CAN reply ID", 0, 2047, 2, access("RWA"), Unit::kAddress, "CAN identifier of the module's replies"}, global_field<&GlobalConfig::can_reply_id>()},
+    {{71, "CAN ID", 0, 2047, 1, access("RWA"), Unit::kAddress, "CAN identifier the module listens to"}, global_field<&GlobalConfig::can_id>()},
+    {{73, "EEPROM lock", 0, kUnlockCode, 0, access("RW"), Unit::kNone, "Write 1234 to lock, 4321 to unlock (kept over power-up); reads 1 while locked. Locked: STAP, STGP, stored SGP and stored coordinates answer status 5"},
+     {[](Tmcm142& m, uint8_t) { return m.eeprom_locked() ? 1 : 0; },
+      [](Tmcm142& m, uint8_t, int32_t value) { return m.set_eeprom_lock(value); }}},
+    {{75, "telegram pause time", 0, 255, 0, access("RWA"), Unit::kMillisecond, "Pause before a serial reply is sent"}, global_field<&GlobalConfig::telegram_pause_ms>()},
+    {{76, "serial host address", 1, 255, 2, access("RWA"), Unit::kAddress, "Host address used in replies"}, global_field<&GlobalConfig::serial_host_address>()},
+    {{77, "auto start mode", 0, 1, 1, access("RWA"), Unit::kNone, "1 starts the TMCL program after power-up"}, global_field<&GlobalConfig::auto_start_mode>()},
+    {{84, "coordinate storage", 0, 1, 0, access("RWA"), Unit::kNone, "0 coordinates in RAM (SCO/GCO n, 255 copy them), 1 coordinates 1..20 stored at once and restored at power-up"}, global_field<&GlobalConfig::coordinate_storage>()},
+    {{85, "do not restore user variables", 0, 1, 0, access("RWA"), Unit::kNone, "0 user variables 0..55 restored at power-up, 1 they start at 0"}, global_field<&GlobalConfig::skip_user_variable_restore>()},
+  };
+  // GP 133 follows the base's GP 128..132.
+  static constexpr Row kRandomNumberRows[] = {
+    {{133, "random number", 0, kMax32, 0, access("R"), Unit::kNone, "A new pseudo-random number 0..2^31-1 on every read (xorshift, reproducible)"},
+     {[](Tmcm142& m, uint8_t) { return m.next_random(); }, nullptr}},
+  };
+  // clang-format on
+  static constexpr auto kRows = params::join_rows<Tmcm142>(kSettingRows, program_status_rows(), kRandomNumberRows);
+  static constexpr Table kTable = params::sorted_table<Tmcm142>(kRows);
+  return kTable;
+}
 
 }  // namespace motwin::modules::tmcm142
