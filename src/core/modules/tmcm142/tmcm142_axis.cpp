@@ -24,8 +24,7 @@ void Tmcm142Axis::reset_state() {
   search_final_move_ = false;
   switch_stopping_ = false;
   deviation_event_ = false;
-  encoder_started_ = false;
-  encoder_position_q16_ = 0;
+  encoder_ = EncoderCounter{};
   // The field stays where it was: a power-up must not make the rotor jump.
   last_ramp_q32_ = ramp_.position_q32();
   standstill_ticks_ = 0;
@@ -73,7 +72,7 @@ int32_t Tmcm142Axis::set_ramp_mode(int32_t mode) {
 void Tmcm142Axis::stop() { set_target_velocity(0.0); }
 
 void Tmcm142Axis::set_encoder_position(int32_t position) {
-  encoder_position_q16_ = static_cast<int64_t>(position) * 65536;
+  encoder_.position_q16 = static_cast<int64_t>(position) * 65536;
   state.encoder_position = position;
 }
 
@@ -132,16 +131,16 @@ void Tmcm142Axis::read_feedback(const board::StepperFeedback& feedback) {
   state.left_switch_active = left ? 1 : 0;
   state.home_switch_active = (feedback.switches & 4) != 0 ? 1 : 0;
 
-  if (!encoder_started_) {
-    encoder_started_ = true;
-    encoder_last_count_ = feedback.encoder_count;
+  if (!encoder_.started) {
+    encoder_.started = true;
+    encoder_.last_count = feedback.encoder_count;
   }
-  int64_t counts = static_cast<int32_t>(static_cast<uint32_t>(feedback.encoder_count) - static_cast<uint32_t>(encoder_last_count_));
-  encoder_last_count_ = feedback.encoder_count;
+  int64_t counts = static_cast<int32_t>(static_cast<uint32_t>(feedback.encoder_count) - static_cast<uint32_t>(encoder_.last_count));
+  encoder_.last_count = feedback.encoder_count;
   if (config.encoder_direction != 0) counts = -counts;
-  encoder_position_q16_ += counts * config.encoder_constant;
+  encoder_.position_q16 += counts * config.encoder_constant;
   // Nearest microstep; the 32-bit register wraps.
-  state.encoder_position = static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>((encoder_position_q16_ + 32768) >> 16)));
+  state.encoder_position = static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>((encoder_.position_q16 + 32768) >> 16)));
 }
 
 void Tmcm142Axis::run_reference_search() {

@@ -146,10 +146,14 @@ class Tmcm142Axis {
   bool search_final_move_ = false;
   bool switch_stopping_ = false;   // soft stop at a switch: AP 15 deceleration until at rest
   bool deviation_event_ = false;
-  // Encoder: last raw count and the position in 1/65536 µsteps.
-  bool encoder_started_ = false;
-  int32_t encoder_last_count_ = 0;
-  int64_t encoder_position_q16_ = 0;
+  // The ABN encoder counter: the last raw count (read first at power-up) and the position in
+  // 1/65536 µsteps (AP 42 scales each count).
+  struct EncoderCounter {
+    bool started = false;
+    int32_t last_count = 0;
+    int64_t position_q16 = 0;
+  };
+  EncoderCounter encoder_;
   // The microstep sequencer: electrical angle x 2^16 (only the low 48 bits matter). It follows
   // the ramp's motion (not its counter, so setting AP 1 never moves the field) plus the easyPID
   // correction.
