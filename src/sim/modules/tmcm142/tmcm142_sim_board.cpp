@@ -44,13 +44,13 @@ std::span<const SignalInfo> Tmcm142SimBoard::signal_table() {
   return table;
 }
 
-Tmcm142SimBoard::Tmcm142SimBoard(Tmcm142SimIo& io) : io_(io) {
+Tmcm142SimBoard::Tmcm142SimBoard(Tmcm142SimIo& io) : SimBoardOverIo(io) {
   apply_sensor_config();
   before_tick();
 }
 
 Tmcm142SimBoard::Tmcm142SimBoard(Tmcm142SimIo& io, const StepperMotorDescription& motor, int sub_steps)
-    : io_(io), plant_(std::make_unique<StepperPlant>(motor, sub_steps)) {
+    : SimBoardOverIo(io), plant_(std::make_unique<StepperPlant>(motor, sub_steps)) {
   ideal_.full_steps_per_revolution = motor.full_steps_per_revolution;
   apply_sensor_config();
   before_tick();

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "board/stepper_drive.h"
+#include "sim/general_io.h"
 #include "sim/signals.h"
 #include "sim/stepper_plant.h"
 #include "sim/stepper_switch_sources.h"
@@ -23,7 +24,7 @@
 
 namespace motwin::sim {
 
-class Tmcm142SimBoard final : public SignalBoard {
+class Tmcm142SimBoard final : public SimBoardOverIo<Tmcm142SimBoard, Tmcm142SimIo> {
  public:
   // Tmcm142SimIo's signals followed by the motor side's (LOAD_TORQUE, ..., ENCODER_FAULT).
   static std::span<const SignalInfo> signal_table();
@@ -35,7 +36,6 @@ class Tmcm142SimBoard final : public SignalBoard {
   Tmcm142SimBoard(Tmcm142SimIo& io, const StepperMotorDescription& motor,
                   int sub_steps = StepperPlant::kDefaultSubSteps);
 
-  Tmcm142SimIo& io() { return io_; }
   board::StepperPowerStage& power_stage() { return stage_; }
   StepperPlant* plant() { return plant_.get(); }
   const StepperPlant* plant() const { return plant_.get(); }
@@ -54,19 +54,16 @@ class Tmcm142SimBoard final : public SignalBoard {
     }
   }
 
-  // SignalBoard.
-  std::span<const SignalInfo> input_signals() const override { return signal_table(); }
+  // SignalBoard (signals and output changes: SimBoardOverIo).
   void set_input(std::string_view name, double value) override;
   // Inputs, outputs and what the motor does: POSITION_REV, SPEED_RPM, ENCODER_COUNT and, with a
   // physical motor, COIL_A_A, COIL_B_A, TORQUE_NM.
   std::optional<double> read_signal(std::string_view name) const override;
-  void take_output_changes(std::vector<OutputChange>& out) override { io_.take_output_changes(out); }
 
  private:
   void apply_motor_settings();
   void apply_sensor_config();
 
-  Tmcm142SimIo& io_;
   std::unique_ptr<StepperPlant> plant_;
   IdealStepper ideal_;
   StepperSensors sensors_;

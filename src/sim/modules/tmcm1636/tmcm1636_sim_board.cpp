@@ -27,11 +27,11 @@ std::span<const SignalInfo> Tmcm1636SimBoard::signal_table() {
   return table;
 }
 
-Tmcm1636SimBoard::Tmcm1636SimBoard(Tmcm1636SimIo& io) : io_(io) {}
+Tmcm1636SimBoard::Tmcm1636SimBoard(Tmcm1636SimIo& io) : SimBoardOverIo(io) {}
 
 Tmcm1636SimBoard::Tmcm1636SimBoard(Tmcm1636SimIo& io, const MotorDescription& motor, uint64_t noise_seed,
                                    int sub_steps)
-    : io_(io), plant_(std::make_unique<Tmcm1636Plant>(motor, noise_seed, Tmcm1636BoardModel{}, sub_steps)) {
+    : SimBoardOverIo(io), plant_(std::make_unique<Tmcm1636Plant>(motor, noise_seed, Tmcm1636BoardModel{}, sub_steps)) {
   io_.set_supply_millivolt(static_cast<int32_t>(std::lround(motor.supply.voltage_v * 1000.0)));
   sense();
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "board/modules/tmcm1636/tmcm1636_power_stage.h"
+#include "sim/general_io.h"
 #include "sim/modules/tmcm1636/motor_description.h"
 #include "sim/signals.h"
 #include "sim/modules/tmcm1636/tmcm1636_plant.h"
@@ -20,7 +21,7 @@
 
 namespace motwin::sim {
 
-class Tmcm1636SimBoard final : public SignalBoard {
+class Tmcm1636SimBoard final : public SimBoardOverIo<Tmcm1636SimBoard, Tmcm1636SimIo> {
  public:
   static constexpr uint64_t kDefaultNoiseSeed = 0x1636;
 
@@ -33,7 +34,6 @@ class Tmcm1636SimBoard final : public SignalBoard {
   Tmcm1636SimBoard(Tmcm1636SimIo& io, const MotorDescription& motor, uint64_t noise_seed = kDefaultNoiseSeed,
                    int sub_steps = Tmcm1636Plant::kDefaultSubSteps);
 
-  Tmcm1636SimIo& io() { return io_; }
   Tmcm1636Plant* plant() { return plant_.get(); }
   const Tmcm1636Plant* plant() const { return plant_.get(); }
   // What the firmware's axis is attached to; nullptr for the ideal motor.
@@ -47,18 +47,15 @@ class Tmcm1636SimBoard final : public SignalBoard {
     if (plant_) plant_->advance(stage_.drive, dt_s);
   }
 
-  // SignalBoard.
-  std::span<const SignalInfo> input_signals() const override { return signal_table(); }
+  // SignalBoard (signals and output changes: SimBoardOverIo).
   void set_input(std::string_view name, double value) override;
   // Inputs, outputs and, with a physical motor, what the plant does: SPEED_RPM, POSITION_REV,
   // VBUS, TORQUE_NM, IQ_A, ID_A, CHOPPER, BRAKE_ENGAGED, DRIVER_TEMP.
   std::optional<double> read_signal(std::string_view name) const override;
-  void take_output_changes(std::vector<OutputChange>& out) override { io_.take_output_changes(out); }
 
  private:
   void sense();
 
-  Tmcm1636SimIo& io_;
   std::unique_ptr<Tmcm1636Plant> plant_;
   board::Tmcm1636PowerStage stage_{};
   // Reference switches driven by the rotor position (REF_R_AT ...): right, left, home.

@@ -5,19 +5,20 @@
 #pragma once
 
 #include <array>
-#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
-#include <vector>
+#include <string_view>
 
 #include "board/modules/tmcm1636/tmcm1636_io.h"
+#include "sim/general_io.h"
 #include "sim/signals.h"
 
 namespace motwin::sim {
 
-class Tmcm1636SimIo final : public board::Tmcm1636Io, public LoggingSignalBoard {
+// AI0 and AI1 are the analog inputs of the signal table; ADC_VM and ADC_TEMP follow VSUPPLY and TEMP.
+class Tmcm1636SimIo final : public SimGeneralIo<Tmcm1636SimIo, board::Tmcm1636Io, 2> {
  public:
-  static constexpr int32_t kDefaultSupplyMillivolt = 24000;
   static constexpr double kDefaultTemperatureCelsius = 25.0;
 
   // GPI0..3, AI0, AI1, VSUPPLY, TEMP, REF_R, REF_L, REF_H.
@@ -25,18 +26,12 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public LoggingSignalBoard 
 
   Tmcm1636SimIo();
 
-  // board::Tmcm1636Io.
-  bool digital_input(uint8_t port) const override;
+  // board::Tmcm1636Io (the digital inputs and outputs: SimGeneralIo).
   uint16_t analog_input(uint8_t channel) const override;
-  void set_digital_output(uint8_t port, bool on) override;
-  bool digital_output(uint8_t port) const override;
   bool reference_switch_level(board::ReferenceSwitch which) const override;
 
-  // Typed setters. Out-of-range ports are ignored; values are clamped to what the ADC reads.
-  void set_digital_input(uint8_t port, bool level);
-  void set_analog_input_raw(uint8_t channel, uint16_t raw);  // AI0 (0) and AI1 (1), 0..4095
+  // Typed setters beyond SimGeneralIo's. Values are clamped to what the ADC reads.
   void set_supply_millivolt(int32_t millivolt);
-  int32_t supply_millivolt() const { return supply_millivolt_; }
   void set_temperature_celsius(double celsius);
   double temperature_celsius() const { return temperature_celsius_; }
   void set_reference_switch_level(board::ReferenceSwitch which, bool level);
@@ -46,20 +41,15 @@ class Tmcm1636SimIo final : public board::Tmcm1636Io, public LoggingSignalBoard 
   void set_measured_supply_raw(uint16_t raw) { supply_raw_ = raw; }
   void set_measured_temperature_celsius(double celsius);
 
-
   // SignalBoard.
   std::span<const SignalInfo> input_signals() const override { return signal_table(); }
   void set_input(std::string_view name, double value) override;
   std::optional<double> read_signal(std::string_view name) const override;
 
  private:
-  std::array<bool, kDigitalInputCount> digital_inputs_{};
-  std::array<uint16_t, 2> analog_inputs_raw_{};
-  int32_t supply_millivolt_ = kDefaultSupplyMillivolt;
   uint16_t supply_raw_ = 0;
   double temperature_celsius_ = kDefaultTemperatureCelsius;
   uint16_t temperature_raw_ = 0;
-  std::array<bool, kDigitalOutputCount> digital_outputs_{};
   std::array<bool, 3> reference_switch_levels_{};
 };
 
