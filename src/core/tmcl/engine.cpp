@@ -152,57 +152,127 @@ CommandResult TmclEngine::control_command(const Instruction& in) {
   }
 }
 
+// The steps of one instruction: download mode stores it, the program-control commands and the
+// interrupt bank are the engine's own, everything else goes to its command family.
 CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelId channel) {
-  const int32_t echo = in.value;
   if (origin == Origin::kHost && device_.runtime().download_mode && !is_control_command(in.command)) {
     return store_downloaded(in);
   }
   if (in.command >= command::kStopApplication && in.command <= command::kGetApplicationStatus) {
-    if (origin == Origin::kProgram) return status_only(Status::kInvalidCommand, echo);
+    if (origin == Origin::kProgram) return status_only(Status::kInvalidCommand, in.value);
     return control_command(in);
   }
-  // Interrupt configuration: SGP/GGP/AGP on bank 3.
-  if (in.motor_bank == kInterruptBank &&
-      (in.command == command::kSgp || in.command == command::kGgp || in.command == command::kAgp)) {
-    if (in.command == command::kGgp) {
-      int32_t value = 0;
-      const Status status = interpreter_.get_interrupt_parameter(in.type, value);
-      return read_result(status, value, echo);
-    }
-    const int32_t value = in.command == command::kSgp ? in.value : device_.runtime().accumulator;
-    return status_only(interpreter_.set_interrupt_parameter(in.type, value), echo);
-  }
-  const bool motor_ok = in.motor_bank < device_.motor_count();
+  if (is_interrupt_configuration(in)) return interrupt_configuration(in);
   switch (in.command) {
     case command::kRor:
-    case command::kRol: {
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
-      // ROL negates; -INT32_MIN does not fit and is out of every velocity range anyway.
-      if (in.command == command::kRol && in.value == INT32_MIN) return status_only(Status::kInvalidValue, echo);
-      const int32_t velocity = in.command == command::kRol ? -in.value : in.value;
-      return status_only(device_.rotate(in.motor_bank, velocity), echo);
-    }
+    case command::kRol:
     case command::kMst:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
-      return status_only(device_.stop(in.motor_bank), echo);
     case command::kMvp:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
-      return status_only(device_.move(in.motor_bank, in.type, in.value), echo);
+      return motion_command(in);
     case command::kSap:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
+    case command::kGap:
+    case command::kStap:
+    case command::kRsap:
+    case command::kAap:
+      return axis_parameter_command(in);
+    case command::kSgp:
+    case command::kGgp:
+    case command::kStgp:
+    case command::kRsgp:
+    case command::kAgp:
+      return global_parameter_command(in);
+    case command::kSio:
+    case command::kGio:
+    case command::kRfs:
+    case command::kSco:
+    case command::kAco:
+    case command::kGco:
+    case command::kCco:
+      return device_command(in);
+    case command::kNop:
+    case command::kCalc:
+    case command::kCalcx:
+    case command::kComp:
+    case command::kCle:
+      return register_command(in);
+    // Program flow makes no sense from a host (manual 2.5.3): "command not available".
+    case command::kJc:
+    case command::kJa:
+    case command::kCsub:
+    case command::kRsub:
+    case command::kWait:
+    case command::kStop:
+      return status_only(Status::kNotAvailable, in.value);
+    case command::kGetFirmwareVersion:
+    case command::kRestoreFactoryDefaults:
+    case command::kRequestPositionReachedEvent:
+    case command::kEnterAsciiMode:
+    case command::kSoftwareReset:
+      return module_command(in, channel);
+    default:
+      return status_only(Status::kInvalidCommand, in.value);
+  }
+}
+
+// Interrupt configuration: SGP/GGP/AGP on bank 3 belong to the interpreter.
+bool TmclEngine::is_interrupt_configuration(const Instruction& in) {
+  return in.motor_bank == kInterruptBank &&
+         (in.command == command::kSgp || in.command == command::kGgp || in.command == command::kAgp);
+}
+
+CommandResult TmclEngine::interrupt_configuration(const Instruction& in) {
+  if (in.command == command::kGgp) {
+    int32_t value = 0;
+    const Status status = interpreter_.get_interrupt_parameter(in.type, value);
+    return read_result(status, value, in.value);
+  }
+  const int32_t value = in.command == command::kSgp ? in.value : device_.runtime().accumulator;
+  return status_only(interpreter_.set_interrupt_parameter(in.type, value), in.value);
+}
+
+// ROR, ROL, MST, MVP on a motor of the module.
+CommandResult TmclEngine::motion_command(const Instruction& in) {
+  const int32_t echo = in.value;
+  if (in.motor_bank >= device_.motor_count()) return status_only(Status::kInvalidValue, echo);
+  switch (in.command) {
+    case command::kRor:
+      return status_only(device_.rotate(in.motor_bank, in.value), echo);
+    case command::kRol:
+      // ROL negates; -INT32_MIN does not fit and is out of every velocity range anyway.
+      if (in.value == INT32_MIN) return status_only(Status::kInvalidValue, echo);
+      return status_only(device_.rotate(in.motor_bank, -in.value), echo);
+    case command::kMst:
+      return status_only(device_.stop(in.motor_bank), echo);
+    default:  // MVP
+      return status_only(device_.move(in.motor_bank, in.type, in.value), echo);
+  }
+}
+
+// SAP, GAP, STAP, RSAP, AAP on a motor of the module.
+CommandResult TmclEngine::axis_parameter_command(const Instruction& in) {
+  const int32_t echo = in.value;
+  if (in.motor_bank >= device_.motor_count()) return status_only(Status::kInvalidValue, echo);
+  switch (in.command) {
+    case command::kSap:
       return status_only(device_.set_axis_parameter(in.type, in.motor_bank, in.value), echo);
     case command::kGap: {
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
       int32_t value = 0;
       const Status status = device_.get_axis_parameter(in.type, in.motor_bank, value);
       return read_result(status, value, echo);
     }
     case command::kStap:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
       return status_only(device_.store_axis_parameter(in.type, in.motor_bank), echo);
     case command::kRsap:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
       return status_only(device_.restore_axis_parameter(in.type, in.motor_bank), echo);
+    default:  // AAP
+      return status_only(device_.set_axis_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
+  }
+}
+
+// SGP, GGP, STGP, RSGP, AGP: the bank is the device's to check.
+CommandResult TmclEngine::global_parameter_command(const Instruction& in) {
+  const int32_t echo = in.value;
+  switch (in.command) {
     case command::kSgp:
       return status_only(device_.set_global_parameter(in.type, in.motor_bank, in.value), echo);
     case command::kGgp: {
@@ -214,17 +284,25 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       return status_only(device_.store_global_parameter(in.type, in.motor_bank), echo);
     case command::kRsgp:
       return status_only(device_.restore_global_parameter(in.type, in.motor_bank), echo);
+    default:  // AGP
+      return status_only(device_.set_global_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
+  }
+}
+
+// SIO, GIO, RFS and the coordinates: the motor or bank byte is the device's to check, so that a
+// module without RFS or coordinates answers status 2 whatever the operands (255 selects the
+// coordinates' EEPROM copies).
+CommandResult TmclEngine::device_command(const Instruction& in) {
+  const int32_t echo = in.value;
+  int32_t value = 0;
+  switch (in.command) {
     case command::kSio:
       return status_only(device_.set_output(in.type, in.motor_bank, in.value), echo);
     case command::kGio: {
-      int32_t value = 0;
       const Status status = device_.get_input(in.type, in.motor_bank, value);
       return read_result(status, value, echo);
     }
-    // RFS and coordinates: the motor byte is the device's to check, so that a module without
-    // them answers status 2 whatever the operands (255 selects the coordinates' EEPROM copies).
     case command::kRfs: {
-      int32_t value = 0;
       const Status status = device_.reference_search(in.motor_bank, in.type, value);
       // STATUS is a read (a program loads the accumulator); START and STOP echo the operand.
       if (in.type == 2) return read_result(status, value, echo);
@@ -235,39 +313,41 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
     case command::kAco:
       return status_only(device_.set_coordinate(in.type, in.motor_bank, device_.runtime().accumulator), echo);
     case command::kGco: {
-      int32_t value = 0;
       const Status status = device_.get_coordinate(in.type, in.motor_bank, value);
       return read_result(status, value, echo);
     }
-    case command::kCco:
+    default:  // CCO
       return status_only(device_.capture_coordinate(in.type, in.motor_bank), echo);
-    case command::kNop:
-      return status_only(Status::kOk, echo);
+  }
+}
+
+// NOP, CALC, CALCX, COMP, CLE: the registers shared with a running program.
+CommandResult TmclEngine::register_command(const Instruction& in) {
+  const int32_t echo = in.value;
+  TmclRuntime& runtime = device_.runtime();
+  switch (in.command) {
     case command::kCalc:
-      return status_only(calculate(device_.runtime(), in.type, in.value, false), echo);
+      return status_only(calculate(runtime, in.type, in.value, false), echo);
     case command::kCalcx:
-      return status_only(calculate(device_.runtime(), in.type, device_.runtime().x_register, true), echo);
+      return status_only(calculate(runtime, in.type, runtime.x_register, true), echo);
     case command::kComp:
-      device_.runtime().compare_accumulator = device_.runtime().accumulator;
-      device_.runtime().compare_operand = in.value;
+      runtime.compare_accumulator = runtime.accumulator;
+      runtime.compare_operand = in.value;
       return status_only(Status::kOk, echo);
-    case command::kAap:
-      if (!motor_ok) return status_only(Status::kInvalidValue, echo);
-      return status_only(device_.set_axis_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
-    case command::kAgp:
-      return status_only(device_.set_global_parameter(in.type, in.motor_bank, device_.runtime().accumulator), echo);
-    // Program flow makes no sense from a host (manual 2.5.3): "command not available".
-    case command::kJc:
-    case command::kJa:
-    case command::kCsub:
-    case command::kRsub:
-    case command::kWait:
-    case command::kStop:
-      return status_only(Status::kNotAvailable, echo);
     case command::kCle:
       if (in.type >= sizeof(kCleMasks)) return status_only(Status::kWrongType, echo);
-      device_.runtime().error_flags &= static_cast<uint8_t>(~kCleMasks[in.type]);
+      runtime.error_flags &= static_cast<uint8_t>(~kCleMasks[in.type]);
       return status_only(Status::kOk, echo);
+    default:  // NOP
+      return status_only(Status::kOk, echo);
+  }
+}
+
+// Commands 136, 137, 138, 139 and 255: firmware version, factory defaults, the position event,
+// ASCII mode and reset.
+CommandResult TmclEngine::module_command(const Instruction& in, ChannelId channel) {
+  const int32_t echo = in.value;
+  switch (in.command) {
     case command::kGetFirmwareVersion:
       if (in.type == 0) return CommandResult{Status::kOk, echo, ReplyKind::kVersionString, false};
       if (in.type == 1) return CommandResult{Status::kOk, device_.identity().binary_version(), ReplyKind::kNormal, false};
@@ -281,20 +361,17 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
       return CommandResult{Status::kOk, echo, ReplyKind::kNone, false};
     case command::kRequestPositionReachedEvent:
       return request_position_event(in, channel);
-    case command::kEnterAsciiMode:
+    case command::kEnterAsciiMode: {
       // Only on modules with the ASCII interface: their global table has GP 67 (ascii_link.h).
-      {
-        int32_t configuration = 0;
-        if (device_.get_global_parameter(ascii_config::kGlobalParameter, 0, configuration) != Status::kOk) {
-          return status_only(Status::kInvalidCommand, echo);
-        }
+      int32_t configuration = 0;
+      if (device_.get_global_parameter(ascii_config::kGlobalParameter, 0, configuration) != Status::kOk) {
+        return status_only(Status::kInvalidCommand, echo);
       }
       return CommandResult{Status::kOk, echo, ReplyKind::kThenAsciiMode, false};
-    case command::kSoftwareReset:
+    }
+    default:  // 255
       if (in.value != kResetMagic) return status_only(Status::kInvalidValue, echo);
       return CommandResult{Status::kOk, echo, ReplyKind::kThenReset, false};
-    default:
-      return status_only(Status::kInvalidCommand, echo);
   }
 }
 

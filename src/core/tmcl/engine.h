@@ -86,9 +86,18 @@ class TmclEngine {
   };
   static constexpr size_t kMaxPendingEvents = 16;
 
-  CommandResult request_position_event(const Instruction& in, ChannelId channel);
-  CommandResult control_command(const Instruction& in);
+  // The steps of execute(), one per command family.
   CommandResult store_downloaded(const Instruction& in);
+  CommandResult control_command(const Instruction& in);
+  static bool is_interrupt_configuration(const Instruction& in);
+  CommandResult interrupt_configuration(const Instruction& in);
+  CommandResult motion_command(const Instruction& in);
+  CommandResult axis_parameter_command(const Instruction& in);
+  CommandResult global_parameter_command(const Instruction& in);
+  CommandResult device_command(const Instruction& in);
+  CommandResult register_command(const Instruction& in);
+  CommandResult module_command(const Instruction& in, ChannelId channel);
+  CommandResult request_position_event(const Instruction& in, ChannelId channel);
 
   TmclDevice& device_;
   std::array<PendingEvent, kMaxPendingEvents> events_{};
