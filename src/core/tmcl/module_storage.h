@@ -5,7 +5,7 @@
 //   - static axis_parameters(), global_parameters() (params::ParameterTable<Derived>),
 //   - static constexpr kNvmLayout and kMotorCount,
 //   - void clear_ram_state()        power-up: config and state structs back to their defaults,
-// and may hide these defaults:
+// (the TMCL module base, tmcl_module.h, provides all but the tables) and may hide these defaults:
 //   - before_axis_restore()         e.g. read a unit mode first that the other rows depend on,
 //   - after_axis_restore(), after_restore(),
 //   - skip_user_variable_restore()  GP 85,
