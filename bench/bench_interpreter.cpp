@@ -53,11 +53,11 @@ Rig make_rig(const std::string& source) {
   host::ModuleOptions options;
   options.log = [](const std::string&) {};
   host::MakeModuleResult made = host::make_module("tmcm-1636", options);
-  if (!made.module) {
-    std::fprintf(stderr, "bench_interpreter: %s\n", made.error.c_str());
+  if (!made) {
+    std::fprintf(stderr, "bench_interpreter: %s\n", made.error().c_str());
     std::exit(2);
   }
-  Rig rig{std::move(made.module), nullptr};
+  Rig rig{std::move(*made), nullptr};
   tmcl::TmclEngine& engine = rig.module->engine();
   if (!source.empty()) {
     const tools::AssemblyResult assembled = tools::assemble_source(source, "bench.tmc");

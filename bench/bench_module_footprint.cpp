@@ -67,20 +67,20 @@ int main() {
   std::vector<std::unique_ptr<host::VirtualModule>> kept;
   for (const host::ModuleDescriptor& descriptor : host::registered_modules()) {
     auto warm_up = make(descriptor);
-    if (!warm_up.module) {
+    if (!warm_up) {
       std::fprintf(stderr, "bench_module_footprint: %.*s: %s\n", static_cast<int>(descriptor.name.size()),
-                   descriptor.name.data(), warm_up.error.c_str());
+                   descriptor.name.data(), warm_up.error().c_str());
       status = 2;
       continue;
     }
-    warm_up.module->run_ticks(1000);
+    (*warm_up)->run_ticks(1000);
 
     std::vector<std::unique_ptr<host::VirtualModule>> instances;
     const long before = resident_bytes();
     for (int i = 0; i < kInstances; ++i) {
       auto made = make(descriptor);
-      made.module->run_ticks(10);  // touch what a running module touches
-      instances.push_back(std::move(made.module));
+      (*made)->run_ticks(10);  // touch what a running module touches
+      instances.push_back(std::move(*made));
     }
     const long per_instance = (resident_bytes() - before) / kInstances;
 
@@ -95,7 +95,7 @@ int main() {
     std::printf("| %.*s | %s B | %.1f KiB | %d | %.0fx |\n", static_cast<int>(descriptor.name.size()),
                 descriptor.name.data(), core_size(descriptor.name).c_str(), static_cast<double>(per_instance) / 1024.0,
                 kInstances, kSimulatedSeconds / best);
-    kept.push_back(std::move(warm_up.module));
+    kept.push_back(std::move(*warm_up));
     for (auto& instance : instances) kept.push_back(std::move(instance));
   }
   return status;

@@ -74,11 +74,12 @@ class SyncPdoRig {
     motwin::host::ModuleOptions options;
     options.node_id = kNode;
     options.log = [](const std::string&) {};
-    module_ = motwin::host::make_module("tmcm-3216", options).module;
-    if (!module_) {
+    motwin::host::MakeModuleResult made = motwin::host::make_module("tmcm-3216", options);
+    if (!made) {
       error_ = "cannot make the tmcm-3216";
       return;
     }
+    module_ = std::move(*made);
     bus_.set_clock([this] { return module_->sim_time_us(); });
     bus_.set_bit_rate(1'000'000);
     master_id_ = bus_.attach(master_);

@@ -19,20 +19,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace motwin;
   if (size > 16 * 1024) return 0;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  const sim::MotorLoadResult loaded = sim::parse_motor_description(text, "fuzz.json");
-  if (!loaded.motor) {
-    FUZZ_CHECK(loaded.error.rfind("fuzz.json", 0) == 0, "error without its source: %s", loaded.error.c_str());
+  const Result<sim::MotorDescription> loaded = sim::parse_motor_description(text, "fuzz.json");
+  if (!loaded) {
+    FUZZ_CHECK(loaded.error().rfind("fuzz.json", 0) == 0, "error without its source: %s", loaded.error().c_str());
     return 0;
   }
-  const std::string json = sim::motor_description_json(*loaded.motor);
-  const sim::MotorLoadResult again = sim::parse_motor_description(json, "written.json");
-  FUZZ_CHECK(again.motor.has_value(), "the written description does not load: %s\n%s", again.error.c_str(),
-             json.c_str());
-  FUZZ_CHECK(sim::motor_description_json(*again.motor) == json, "writing the description is not stable:\n%s",
+  const std::string json = sim::motor_description_json(*loaded);
+  const Result<sim::MotorDescription> again = sim::parse_motor_description(json, "written.json");
+  FUZZ_CHECK(again.ok(), "the written description does not load: %s\n%s", again.error().c_str(), json.c_str());
+  FUZZ_CHECK(sim::motor_description_json(*again) == json, "writing the description is not stable:\n%s",
              json.c_str());
 
   sim::Tmcm1636SimIo io;
-  sim::Tmcm1636SimBoard board(io, *loaded.motor);
+  sim::Tmcm1636SimBoard board(io, *loaded);
   for (int tick = 0; tick < 400; ++tick) {
     board.before_tick();
     board.after_tick(50e-6);

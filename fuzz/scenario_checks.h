@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "fuzz_support.h"
 #include "sim/scenario.h"
@@ -16,21 +17,21 @@
 
 namespace motwin::fuzz {
 
-inline void check_scenario_events(const sim::ScenarioParseResult& result, std::string_view text,
+inline void check_scenario_events(const std::vector<sim::ScenarioEvent>& events, std::string_view text,
                                   std::span<const sim::SignalInfo> signals) {
   size_t lines = 1;
   for (char c : text) lines += c == '\n' ? 1 : 0;
-  for (size_t i = 0; i < result.events.size(); ++i) {
-    const sim::ScenarioEvent& event = result.events[i];
+  for (size_t i = 0; i < events.size(); ++i) {
+    const sim::ScenarioEvent& event = events[i];
     const sim::SignalInfo* signal = sim::find_signal(signals, event.signal);
     FUZZ_CHECK(signal != nullptr && signal->name == event.signal, "event signal '%s'", event.signal.c_str());
-    FUZZ_CHECK(std::isfinite(event.value) && sim::check_signal_value(*signal, event.value).empty(), "%s = %g",
+    FUZZ_CHECK(std::isfinite(event.value) && sim::check_signal_value(*signal, event.value).ok(), "%s = %g",
                event.signal.c_str(), event.value);
     FUZZ_CHECK(event.time_us <= static_cast<uint64_t>(sim::kMaxScenarioTimeS * 1e6), "time %llu us",
                static_cast<unsigned long long>(event.time_us));
     FUZZ_CHECK(event.line >= 1 && event.line <= lines, "line %zu of %zu", event.line, lines);
     if (i > 0) {
-      const sim::ScenarioEvent& previous = result.events[i - 1];
+      const sim::ScenarioEvent& previous = events[i - 1];
       FUZZ_CHECK(previous.time_us < event.time_us || (previous.time_us == event.time_us && previous.line < event.line),
                  "events %zu and %zu out of order", i - 1, i);
     }

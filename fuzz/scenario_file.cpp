@@ -29,15 +29,15 @@ using namespace motwin;
 // Parses `text` against `signals`; the events that parse are played on the board `make_board` gives.
 template <typename MakeBoard>
 void parse_and_play(std::string_view text, std::span<const sim::SignalInfo> signals, MakeBoard make_board) {
-  sim::ScenarioParseResult result = sim::parse_scenario(text, "fuzz.scn", signals);
+  Result<std::vector<sim::ScenarioEvent>> result = sim::parse_scenario(text, "fuzz.scn", signals);
   if (!result.ok()) {
-    FUZZ_CHECK(result.error.rfind("fuzz.scn:", 0) == 0, "error without its source: %s", result.error.c_str());
+    FUZZ_CHECK(result.error().rfind("fuzz.scn:", 0) == 0, "error without its source: %s", result.error().c_str());
     return;
   }
-  fuzz::check_scenario_events(result, text, signals);
-  const size_t count = result.events.size();
+  fuzz::check_scenario_events(*result, text, signals);
+  const size_t count = result->size();
   make_board([&](sim::SignalBoard& board) {
-    sim::ScenarioPlayer player(std::move(result.events), board);
+    sim::ScenarioPlayer player(std::move(*result), board);
     FUZZ_CHECK(player.apply_due(UINT64_MAX) == count && player.finished(), "not every event was applied");
   });
 }

@@ -27,6 +27,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm142/tmcm142.h"
@@ -44,12 +45,13 @@ using namespace motwin;
 using Tmcm142 = modules::tmcm142::Tmcm142;
 using Tmcm142Nvm = board::RamNonVolatileMemory<Tmcm142::kNvmLayout.total_size>;
 
-void check_motor(const sim::StepperMotorChoice& choice) {
-  if (!choice.motor) {
-    FUZZ_CHECK(choice.error.rfind("fuzz-motor.json: ", 0) == 0, "error without its source: %s", choice.error.c_str());
+void check_motor(const Result<sim::StepperMotorDescription>& loaded) {
+  if (!loaded) {
+    FUZZ_CHECK(loaded.error().rfind("fuzz-motor.json: ", 0) == 0, "error without its source: %s",
+               loaded.error().c_str());
     return;
   }
-  const sim::StepperMotorDescription& m = *choice.motor;
+  const sim::StepperMotorDescription& m = *loaded;
   for (double value : {m.resistance_ohm, m.inductance_h, m.torque_constant_nm_per_a, m.rotor_inertia_kg_m2,
                        m.rated_current_a}) {
     FUZZ_CHECK(std::isfinite(value) && value > 0.0, "a loaded motor with %g where a positive number belongs", value);
@@ -77,28 +79,29 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view json = rest.substr(0, nul);
   const std::string_view scenario = nul == std::string_view::npos ? std::string_view() : rest.substr(nul + 1);
 
-  const sim::StepperMotorChoice motor = sim::parse_stepper_motor_description(json, "fuzz-motor.json");
+  const Result<sim::StepperMotorDescription> motor = sim::parse_stepper_motor_description(json, "fuzz-motor.json");
   check_motor(motor);
-  sim::ScenarioParseResult events = sim::parse_scenario(scenario, "fuzz.scn", sim::Tmcm142SimBoard::signal_table());
-  if (!events.ok()) {
-    FUZZ_CHECK(events.error.rfind("fuzz.scn:", 0) == 0, "error without its source: %s", events.error.c_str());
-    events.events.clear();
+  const Result<std::vector<sim::ScenarioEvent>> parsed =
+      sim::parse_scenario(scenario, "fuzz.scn", sim::Tmcm142SimBoard::signal_table());
+  if (!parsed.ok()) {
+    FUZZ_CHECK(parsed.error().rfind("fuzz.scn:", 0) == 0, "error without its source: %s", parsed.error().c_str());
   }
+  std::vector<sim::ScenarioEvent> events = parsed.ok() ? *parsed : std::vector<sim::ScenarioEvent>{};
   fuzz::check_scenario_events(events, scenario, sim::Tmcm142SimBoard::signal_table());
   if (std::getenv("MOTWIN_FUZZ_TRACE") != nullptr) {  // for reading a saved input
-    std::fprintf(stderr, "motor: %s; scenario: %zu events %s\n", motor.motor ? motor.motor->name.c_str() : motor.error.c_str(),
-                 events.events.size(), events.error.c_str());
+    std::fprintf(stderr, "motor: %s; scenario: %zu events %s\n", motor ? motor->name.c_str() : motor.error().c_str(),
+                 events.size(), parsed.error().c_str());
   }
-  const size_t event_count = events.events.size();
+  const size_t event_count = events.size();
 
   // As Tmcm142VirtualModule::make and run_ticks wire them.
   auto io = std::make_unique<sim::Tmcm142SimIo>();
-  const bool physical = (control & 1) != 0 && motor.motor.has_value();
-  auto board = physical ? std::make_unique<sim::Tmcm142SimBoard>(*io, *motor.motor)
+  const bool physical = (control & 1) != 0 && motor.ok();
+  auto board = physical ? std::make_unique<sim::Tmcm142SimBoard>(*io, *motor)
                         : std::make_unique<sim::Tmcm142SimBoard>(*io);
   auto nvm = std::make_unique<Tmcm142Nvm>();
   Tmcm142::format_factory_image(nvm->mutable_data(), nvm->size());
-  sim::ScenarioPlayer player(std::move(events.events), *board);
+  sim::ScenarioPlayer player(std::move(events), *board);
   player.apply_due(0);  // time-0 events are the initial inputs
   board->before_tick();
   auto module = std::make_unique<Tmcm142>(*nvm, board->power_stage(), *io);

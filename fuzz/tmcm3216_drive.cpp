@@ -199,7 +199,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const sim::SignalInfo& signal = signals[in.ConsumeIntegralInRange<size_t>(0, signals.size() - 1)];
         double value = in.ConsumeFloatingPointInRange<double>(signal.min, signal.max);
         if (signal.whole_numbers_only) value = static_cast<double>(static_cast<int64_t>(value));
-        if (sim::check_signal_value(signal, value).empty()) board->set_input(signal.name, value);
+        if (sim::check_signal_value(signal, value).ok()) board->set_input(signal.name, value);
         send = false;
         break;
       }

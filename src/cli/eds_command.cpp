@@ -34,10 +34,11 @@ void add_eds_command(CLI::App& app, int& exit_status) {
     std::optional<uint8_t> node_id;
     if (options->node_id != 0) node_id = static_cast<uint8_t>(options->node_id);
     const host::ModuleDescriptor* module = host::find_module(options->module);
-    const std::optional<std::string> text = module != nullptr ? tools::write_module_eds(*module, node_id) : std::nullopt;
+    const Result<std::string> text = module != nullptr
+                                         ? tools::write_module_eds(*module, node_id)
+                                         : Error{"module \"" + options->module + "\" has no CANopen object dictionary"};
     if (!text) {
-      print_error("module \"" + options->module + "\" has no CANopen object dictionary (available: " + canopen_modules +
-                  ")");
+      print_error(text.error() + " (available: " + canopen_modules + ")");
       exit_status = kExitUsageError;
       return;
     }

@@ -183,22 +183,22 @@ int run_run(const RunOptions& options) {
   // The module, as `motwin serve` makes it.
   host::ModuleOptions module_options;
   module_options.motor = options.motor_model;
-  std::string error;
   for (const std::string& text : options.assignments) {
-    const std::optional<sim::SignalAssignment> assignment =
-        sim::parse_signal_assignment(descriptor->input_signals(), text, error);
-    if (!assignment) throw RunError{"--set " + text + ": " + error};
+    const Result<sim::SignalAssignment> assignment = sim::parse_signal_assignment(descriptor->input_signals(), text);
+    if (!assignment) throw RunError{"--set " + text + ": " + assignment.error()};
     module_options.initial_inputs.push_back(host::InitialInput{std::string(assignment->signal->name), assignment->value});
   }
-  std::optional<sim::ScenarioParseResult> scenario;
+  std::optional<std::vector<sim::ScenarioEvent>> scenario;
   if (!options.scenario_path.empty()) {
-    scenario = sim::load_scenario_file(options.scenario_path, descriptor->input_signals());
-    if (!scenario->ok()) throw RunError{scenario->error};
+    Result<std::vector<sim::ScenarioEvent>> events =
+        sim::load_scenario_file(options.scenario_path, descriptor->input_signals());
+    if (!events) throw RunError{events.error()};
+    scenario = std::move(*events);
   }
   if (options.state_dir != host::kNoStateDir) module_options.state_dir = options.state_dir;
   host::MakeModuleResult made = descriptor->make(module_options);
-  if (!made.module) throw RunError{made.error};
-  host::VirtualModule& module = *made.module;
+  if (!made) throw RunError{made.error()};
+  host::VirtualModule& module = **made;
   if (!module.has_tmcl()) throw RunError{fmt::format("{} has no TMCL interpreter", module.name())};
   const uint64_t tick_us = module.tick_period_us();
   const uint64_t sample_ticks = *sample_us / tick_us;
@@ -238,7 +238,7 @@ int run_run(const RunOptions& options) {
 
   download(engine, program->instructions);
   host::HostRuntime runtime(module, host::Pacing::fast());
-  if (scenario) runtime.set_scenario(std::move(scenario->events));
+  if (scenario) runtime.set_scenario(std::move(*scenario));
   runtime.set_output_listener([&report](const sim::OutputChange& change) {
     report << "output " << change.signal << ' ' << change.level << " at " << format_seconds(change.sim_time_us) << '\n';
   });

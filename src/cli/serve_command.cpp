@@ -180,20 +180,20 @@ int run_serve(const ServeArguments& arguments) {
   if (const Result<void> hook = host::install_persist_crash_hook_from_environment(); !hook) {
     throw ServeError{hook.error()};
   }
-  std::string error;
 
   host::ModuleOptions options;
   options.motor = arguments.motor;
   for (const std::string& text : arguments.assignments) {
-    const std::optional<sim::SignalAssignment> assignment =
-        sim::parse_signal_assignment(descriptor->input_signals(), text, error);
-    if (!assignment) throw ServeError{"--set " + text + ": " + error};
+    const Result<sim::SignalAssignment> assignment = sim::parse_signal_assignment(descriptor->input_signals(), text);
+    if (!assignment) throw ServeError{"--set " + text + ": " + assignment.error()};
     options.initial_inputs.push_back(host::InitialInput{std::string(assignment->signal->name), assignment->value});
   }
-  std::optional<sim::ScenarioParseResult> scenario;
+  std::optional<std::vector<sim::ScenarioEvent>> scenario;
   if (!arguments.scenario_path.empty()) {
-    scenario = sim::load_scenario_file(arguments.scenario_path, descriptor->input_signals());
-    if (!scenario->ok()) throw ServeError{scenario->error};
+    Result<std::vector<sim::ScenarioEvent>> events =
+        sim::load_scenario_file(arguments.scenario_path, descriptor->input_signals());
+    if (!events) throw ServeError{events.error()};
+    scenario = std::move(*events);
   }
   std::vector<host::TcpEndpointSpec> tcp_specs;
   for (const std::string& text : arguments.tcp_endpoints) {
@@ -227,8 +227,8 @@ int run_serve(const ServeArguments& arguments) {
   }
   std::vector<host::NodeSpec> node_specs;
   for (size_t i = 0; i < arguments.nodes.size(); ++i) {
-    const std::optional<host::NodeSpec> spec = host::parse_node_spec(arguments.nodes[i], i + 1, error);
-    if (!spec) throw ServeError{"--node " + arguments.nodes[i] + ": " + error};
+    const Result<host::NodeSpec> spec = host::parse_node_spec(arguments.nodes[i], i + 1);
+    if (!spec) throw ServeError{"--node " + arguments.nodes[i] + ": " + spec.error()};
     node_specs.push_back(*spec);
   }
   const std::optional<uint32_t> bit_rate = parse_bit_rate(arguments.can_bitrate);
@@ -246,14 +246,14 @@ int run_serve(const ServeArguments& arguments) {
     }
     tcp_specs.clear();
     if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});
-    host::ModuleGroup::MakeResult made = host::ModuleGroup::make(node_specs, options.state_dir);
-    if (!made.group) throw ServeError{made.error};
-    group = made.group.get();
-    owned_module = std::move(made.group);
+    Result<std::unique_ptr<host::ModuleGroup>> made = host::ModuleGroup::make(node_specs, options.state_dir);
+    if (!made) throw ServeError{made.error()};
+    group = made->get();
+    owned_module = std::move(*made);
   } else {
     host::MakeModuleResult made = descriptor->make(options);
-    if (!made.module) throw ServeError{made.error};
-    owned_module = std::move(made.module);
+    if (!made) throw ServeError{made.error()};
+    owned_module = std::move(*made);
   }
   host::VirtualModule& module = *owned_module;
   if (group == nullptr) {
@@ -268,7 +268,7 @@ int run_serve(const ServeArguments& arguments) {
   }
 
   host::HostRuntime runtime(module, *pacing);
-  if (scenario) runtime.set_scenario(std::move(scenario->events));
+  if (scenario) runtime.set_scenario(std::move(*scenario));
 
   // Endpoints are destroyed before the runtime they are attached to.
   std::vector<std::unique_ptr<host::TmclTcpServer>> tcp_servers;

@@ -20,6 +20,7 @@
 #include "host/module_listing.h"
 #include "host/virtual_module.h"
 #include "sim/signals.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -44,10 +45,9 @@ struct ModuleOptions {
   LogSink log = log_to_stderr;
 };
 
-struct MakeModuleResult {
-  std::unique_ptr<VirtualModule> module;  // powered up and ready for its first tick
-  std::string error;                      // when module is null
-};
+// What make() gives: the module, powered up and ready for its first tick (never null), or why
+// it cannot run (an unknown motor, an unusable state directory, ...).
+using MakeModuleResult = Result<std::unique_ptr<VirtualModule>>;
 
 // Where `motwin serve` puts a module when no endpoint option is given.
 enum class DefaultEndpoint : uint8_t {

@@ -27,15 +27,79 @@ bool valid_name(std::string_view name) {
   return true;
 }
 
+// One KEY=VALUE item of a node spec, applied to `spec`.
+Result<void> apply_node_key(std::string_view item, NodeSpec& spec) {
+  const size_t equals = item.find('=');
+  const std::string_view key = item.substr(0, equals);
+  const std::string_view value = equals == std::string_view::npos ? std::string_view{} : item.substr(equals + 1);
+  if (equals == std::string_view::npos || value.empty()) {
+    return Error{"expected KEY=VALUE, got \"" + std::string(item) + "\""};
+  }
+  const std::optional<long> number = parse_number(value);
+  if (key == "name") {
+    if (!valid_name(value)) {
+      return Error{"name \"" + std::string(value) + "\": letters, digits, '-', '_' and '.' only"};
+    }
+    spec.name = std::string(value);
+  } else if (key == "node-id") {
+    if (!number || *number < 1 || *number > 127) {
+      return Error{"node-id must be 1..127, got \"" + std::string(value) + "\""};
+    }
+    spec.node_id = static_cast<uint8_t>(*number);
+  } else if (key == "serial") {
+    if (!number || *number < 1 || *number > 0xFFFFFFFFL) {
+      return Error{"serial must be 1..4294967295, got \"" + std::string(value) + "\""};
+    }
+    spec.serial_number = static_cast<uint32_t>(*number);
+  } else if (key == "motor") {
+    spec.motor = std::string(value);
+  } else if (key == "receive-id" || key == "send-id") {
+    if (!number || *number < 0 || *number > 255) {
+      return Error{std::string(key) + " must be 0..255 (GP 70/71), got \"" + std::string(value) + "\""};
+    }
+    (key == "receive-id" ? spec.receive_id : spec.send_id) = static_cast<int32_t>(*number);
+  } else {
+    return Error{"unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, receive-id, send-id)"};
+  }
+  return {};
+}
+
+// One member of a group: its module, which must have a CAN interface, with the CAN IDs of its spec.
+Result<std::unique_ptr<VirtualModule>> make_member(const NodeSpec& spec,
+                                                   const std::optional<std::filesystem::path>& state_dir,
+                                                   const LogSink& log) {
+  ModuleOptions options;
+  if (state_dir) options.state_dir = *state_dir / spec.name;
+  options.node_id = spec.node_id;
+  options.serial_number = spec.serial_number;
+  options.motor = spec.motor;
+  options.log = log;
+  MakeModuleResult made = make_module(spec.module, options);
+  if (!made) return made;
+  VirtualModule& module = **made;
+  if (module.can_node() == nullptr) return Error{spec.module + " has no CAN interface"};
+  if (spec.receive_id >= 0 || spec.send_id >= 0) {
+    if (!module.has_tmcl()) return Error{"receive-id/send-id are for TMCL modules (use node-id)"};
+    // As a user would set them once with SGP: GP 70/71 are stored automatically.
+    const auto set = [&module](uint8_t number, int32_t value) {
+      return module.engine().execute(tmcl::Instruction{tmcl::command::kSgp, number, 0, value}, tmcl::Origin::kHost).status;
+    };
+    if ((spec.receive_id >= 0 && set(tmcl::can_parameter::kReceiveId, spec.receive_id) != tmcl::Status::kOk) ||
+        (spec.send_id >= 0 && set(tmcl::can_parameter::kSendId, spec.send_id) != tmcl::Status::kOk)) {
+      return Error{"cannot set the CAN IDs"};
+    }
+  }
+  return made;
+}
+
 }  // namespace
 
-std::optional<NodeSpec> parse_node_spec(std::string_view text, size_t position, std::string& error) {
+Result<NodeSpec> parse_node_spec(std::string_view text, size_t position) {
   NodeSpec spec;
   const size_t colon = text.find(':');
   spec.module = std::string(text.substr(0, colon));
   if (find_module(spec.module) == nullptr) {
-    error = "unknown module \"" + spec.module + "\" (available: " + module_names() + ")";
-    return std::nullopt;
+    return Error{"unknown module \"" + spec.module + "\" (available: " + module_names() + ")"};
   }
   spec.name = spec.module + "-" + std::to_string(position);
   std::string_view rest = colon == std::string_view::npos ? std::string_view{} : text.substr(colon + 1);
@@ -43,102 +107,29 @@ std::optional<NodeSpec> parse_node_spec(std::string_view text, size_t position, 
     const size_t comma = rest.find(',');
     const std::string_view item = rest.substr(0, comma);
     rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
-    const size_t equals = item.find('=');
-    const std::string_view key = item.substr(0, equals);
-    const std::string_view value = equals == std::string_view::npos ? std::string_view{} : item.substr(equals + 1);
-    if (equals == std::string_view::npos || value.empty()) {
-      error = "expected KEY=VALUE, got \"" + std::string(item) + "\"";
-      return std::nullopt;
-    }
-    const std::optional<long> number = parse_number(value);
-    if (key == "name") {
-      if (!valid_name(value)) {
-        error = "name \"" + std::string(value) + "\": letters, digits, '-', '_' and '.' only";
-        return std::nullopt;
-      }
-      spec.name = std::string(value);
-    } else if (key == "node-id") {
-      if (!number || *number < 1 || *number > 127) {
-        error = "node-id must be 1..127, got \"" + std::string(value) + "\"";
-        return std::nullopt;
-      }
-      spec.node_id = static_cast<uint8_t>(*number);
-    } else if (key == "serial") {
-      if (!number || *number < 1 || *number > 0xFFFFFFFFL) {
-        error = "serial must be 1..4294967295, got \"" + std::string(value) + "\"";
-        return std::nullopt;
-      }
-      spec.serial_number = static_cast<uint32_t>(*number);
-    } else if (key == "motor") {
-      spec.motor = std::string(value);
-    } else if (key == "receive-id" || key == "send-id") {
-      if (!number || *number < 0 || *number > 255) {
-        error = std::string(key) + " must be 0..255 (GP 70/71), got \"" + std::string(value) + "\"";
-        return std::nullopt;
-      }
-      (key == "receive-id" ? spec.receive_id : spec.send_id) = static_cast<int32_t>(*number);
-    } else {
-      error = "unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, receive-id, send-id)";
-      return std::nullopt;
-    }
+    if (const Result<void> applied = apply_node_key(item, spec); !applied) return Error{applied.error()};
   }
   return spec;
 }
 
-ModuleGroup::MakeResult ModuleGroup::make(const std::vector<NodeSpec>& specs,
-                                          const std::optional<std::filesystem::path>& state_dir, LogSink log) {
-  MakeResult result;
-  if (specs.empty()) {
-    result.error = "no nodes";
-    return result;
-  }
+Result<std::unique_ptr<ModuleGroup>> ModuleGroup::make(const std::vector<NodeSpec>& specs,
+                                                       const std::optional<std::filesystem::path>& state_dir,
+                                                       LogSink log) {
+  if (specs.empty()) return Error{"no nodes"};
   std::set<std::string> names;
   for (const NodeSpec& spec : specs) {
-    if (!names.insert(spec.name).second) {
-      result.error = "two nodes named \"" + spec.name + "\" (give one a name=...)";
-      return result;
-    }
+    if (!names.insert(spec.name).second) return Error{"two nodes named \"" + spec.name + "\" (give one a name=...)"};
   }
   std::unique_ptr<ModuleGroup> group(new ModuleGroup());
   uint32_t period = 0;
   for (const NodeSpec& spec : specs) {
-    ModuleOptions options;
-    if (state_dir) options.state_dir = *state_dir / spec.name;
-    options.node_id = spec.node_id;
-    options.serial_number = spec.serial_number;
-    options.motor = spec.motor;
-    options.log = log;
-    MakeModuleResult made = make_module(spec.module, options);
-    if (!made.module) {
-      result.error = spec.name + ": " + made.error;
-      return result;
-    }
-    VirtualModule& module = *made.module;
-    if (module.can_node() == nullptr) {
-      result.error = spec.name + ": " + spec.module + " has no CAN interface";
-      return result;
-    }
-    if (spec.receive_id >= 0 || spec.send_id >= 0) {
-      if (!module.has_tmcl()) {
-        result.error = spec.name + ": receive-id/send-id are for TMCL modules (use node-id)";
-        return result;
-      }
-      // As a user would set them once with SGP: GP 70/71 are stored automatically.
-      const auto set = [&module](uint8_t number, int32_t value) {
-        return module.engine().execute(tmcl::Instruction{tmcl::command::kSgp, number, 0, value}, tmcl::Origin::kHost).status;
-      };
-      if ((spec.receive_id >= 0 && set(tmcl::can_parameter::kReceiveId, spec.receive_id) != tmcl::Status::kOk) ||
-          (spec.send_id >= 0 && set(tmcl::can_parameter::kSendId, spec.send_id) != tmcl::Status::kOk)) {
-        result.error = spec.name + ": cannot set the CAN IDs";
-        return result;
-      }
-    }
-    period = std::gcd(period, module.tick_period_us());
-    group->members_.push_back(Member{spec.name, std::move(made.module)});
+    Result<std::unique_ptr<VirtualModule>> member = make_member(spec, state_dir, log);
+    if (!member) return member.error_with_context(spec.name + ": ");
+    period = std::gcd(period, (*member)->tick_period_us());
+    group->members_.push_back(Member{spec.name, std::move(*member)});
   }
   group->tick_period_us_ = period == 0 ? 1 : period;
-  result.group = std::move(group);
-  return result;
+  return group;
 }
 
 tmcl::TmclEngine& ModuleGroup::engine() { std::abort(); }

@@ -12,6 +12,7 @@
 
 #include "host/module_registry.h"
 #include "host/virtual_module.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -26,9 +27,9 @@ struct NodeSpec {
   int32_t send_id = -1;      // send-id=N (GP 70)
 };
 
-// "tmcm-3216:node-id=2,name=left". `position` (1-based) names an unnamed node. nullopt with
-// `error` set for an unknown module or key, or a value out of range.
-std::optional<NodeSpec> parse_node_spec(std::string_view text, size_t position, std::string& error);
+// "tmcm-3216:node-id=2,name=left". `position` (1-based) names an unnamed node. An unknown module
+// or key, or a value out of range, is an error.
+Result<NodeSpec> parse_node_spec(std::string_view text, size_t position);
 
 class ModuleGroup final : public VirtualModule {
  public:
@@ -39,12 +40,9 @@ class ModuleGroup final : public VirtualModule {
 
   // Builds each member (its EEPROM image in <state_dir>/<name>/ when state_dir is set). Two
   // nodes with one name are refused. TMCL modules get the CAN IDs of their spec.
-  struct MakeResult {
-    std::unique_ptr<ModuleGroup> group;
-    std::string error;
-  };
-  static MakeResult make(const std::vector<NodeSpec>& specs, const std::optional<std::filesystem::path>& state_dir,
-                         LogSink log = log_to_stderr);
+  static Result<std::unique_ptr<ModuleGroup>> make(const std::vector<NodeSpec>& specs,
+                                                   const std::optional<std::filesystem::path>& state_dir,
+                                                   LogSink log = log_to_stderr);
 
   std::string_view name() const override { return "bus"; }
   std::string_view firmware_version() const override { return ""; }

@@ -70,9 +70,7 @@ const ModuleDescriptor* first_module(bool (*keep)(const ModuleDescriptor&)) {
 MakeModuleResult make_module(std::string_view name, const ModuleOptions& options) {
   const ModuleDescriptor* module = find_module(name);
   if (module == nullptr) {
-    MakeModuleResult result;
-    result.error = "unknown module \"" + std::string(name) + "\" (available: " + module_names() + ")";
-    return result;
+    return Error{"unknown module \"" + std::string(name) + "\" (available: " + module_names() + ")"};
   }
   return module->make(options);
 }

@@ -68,22 +68,15 @@ class TmclSimModule final : public VirtualModule {
   template <class Motor, class FormatImage, class BuildDevice>
   static MakeModuleResult power_up_on_board(const ModuleOptions& options, const std::optional<Motor>& motor,
                                             const FormatImage& format_image, const BuildDevice& build_device) {
-    MakeModuleResult result;
     std::unique_ptr<TmclSimModule> module(new TmclSimModule());
     const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), format_image);
-    if (!eeprom) return refused(eeprom.error());
+    if (!eeprom) return Error{eeprom.error()};
     module->board_ = motor ? std::make_unique<SimBoard>(module->io_, *motor) : std::make_unique<SimBoard>(module->io_);
     for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
     build_device(*module);
     module->device_->engine().power_up();
     module->can_.emplace(module->device_->engine());
-    result.module = std::move(module);
-    return result;
-  }
-  static MakeModuleResult refused(std::string error) {
-    MakeModuleResult result;
-    result.error = std::move(error);
-    return result;
+    return MakeModuleResult(std::move(module));
   }
 
   SimIo io_;

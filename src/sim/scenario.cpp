@@ -28,15 +28,13 @@ std::vector<std::string_view> split_fields(std::string_view line) {
 
 }  // namespace
 
-ScenarioParseResult parse_scenario(std::string_view text, std::string_view source_name,
-                                   std::span<const SignalInfo> signals) {
-  ScenarioParseResult result;
+Result<std::vector<ScenarioEvent>> parse_scenario(std::string_view text, std::string_view source_name,
+                                                  std::span<const SignalInfo> signals) {
+  std::vector<ScenarioEvent> events;
   size_t line_number = 0;
   size_t position = 0;
   auto fail = [&](const std::string& what) {
-    result.events.clear();
-    result.error = std::string(source_name) + ":" + std::to_string(line_number) + ": " + what;
-    return result;
+    return Error{std::string(source_name) + ":" + std::to_string(line_number) + ": " + what};
   };
   while (position < text.size()) {
     ++line_number;
@@ -64,33 +62,29 @@ ScenarioParseResult parse_scenario(std::string_view text, std::string_view sourc
       return fail("expected a number as the value of " + std::string(signal->name) + ", got \"" +
                   std::string(fields[2]) + "\"");
     }
-    if (std::string problem = check_signal_value(*signal, *value); !problem.empty()) {
-      return fail(problem + ", got " + std::string(fields[2]));
+    if (const Result<void> acceptable = check_signal_value(*signal, *value); !acceptable) {
+      return fail(acceptable.error() + ", got " + std::string(fields[2]));
     }
-    result.events.push_back(ScenarioEvent{static_cast<uint64_t>(std::llround(*time_s * 1e6)), std::string(signal->name),
-                                          *value, line_number});
+    events.push_back(ScenarioEvent{static_cast<uint64_t>(std::llround(*time_s * 1e6)), std::string(signal->name),
+                                   *value, line_number});
   }
-  std::stable_sort(result.events.begin(), result.events.end(),
+  std::stable_sort(events.begin(), events.end(),
                    [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.time_us < b.time_us; });
-  return result;
+  return events;
 }
 
-ScenarioParseResult load_scenario_file(const std::string& path, std::span<const SignalInfo> signals) {
-  ScenarioParseResult result;
+Result<std::vector<ScenarioEvent>> load_scenario_file(const std::string& path, std::span<const SignalInfo> signals) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    result.error = "cannot read scenario file " + path + ": " + std::strerror(errno);
-    return result;
-  }
+  if (fd < 0) return Error{"cannot read scenario file " + path + ": " + std::strerror(errno)};
   std::string contents;
   char buffer[4096];
   for (;;) {
     const ssize_t n = ::read(fd, buffer, sizeof(buffer));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      result.error = "cannot read scenario file " + path + ": " + std::strerror(errno);
+      Error error{"cannot read scenario file " + path + ": " + std::strerror(errno)};
       ::close(fd);
-      return result;
+      return error;
     }
     if (n == 0) break;
     contents.append(buffer, static_cast<size_t>(n));

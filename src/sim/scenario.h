@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "sim/signals.h"
+#include "types/result.h"
 
 namespace motwin::sim {
 
@@ -33,17 +34,12 @@ struct ScenarioEvent {
   size_t line;         // 1-based line in the source, for diagnostics
 };
 
-struct ScenarioParseResult {
-  std::vector<ScenarioEvent> events;  // sorted by time, stable
-  std::string error;                  // "<source>:<line>: <what was expected>"; empty on success
-  bool ok() const { return error.empty(); }
-};
-
-// Parses scenario text; `source_name` names the file in error messages.
-ScenarioParseResult parse_scenario(std::string_view text, std::string_view source_name,
-                                   std::span<const SignalInfo> signals);
+// Parses scenario text: the events sorted by time (stable), or "<source>:<line>: <what was
+// expected>"; `source_name` names the file in error messages.
+Result<std::vector<ScenarioEvent>> parse_scenario(std::string_view text, std::string_view source_name,
+                                                  std::span<const SignalInfo> signals);
 // Reads and parses a file; an unreadable file is an error naming the file and the reason.
-ScenarioParseResult load_scenario_file(const std::string& path, std::span<const SignalInfo> signals);
+Result<std::vector<ScenarioEvent>> load_scenario_file(const std::string& path, std::span<const SignalInfo> signals);
 
 // Applies due events to a board as simulated time advances.
 class ScenarioPlayer {

@@ -31,7 +31,7 @@ const SignalInfo* find_signal(std::span<const SignalInfo> signals, std::string_v
   return nullptr;
 }
 
-std::string check_signal_value(const SignalInfo& signal, double value) {
+Result<void> check_signal_value(const SignalInfo& signal, double value) {
   const bool whole = std::floor(value) == value;
   if (std::isfinite(value) && value >= signal.min && value <= signal.max && (whole || !signal.whole_numbers_only)) {
     return {};
@@ -44,7 +44,7 @@ std::string check_signal_value(const SignalInfo& signal, double value) {
     expected += format_bound(signal.min) + " to " + format_bound(signal.max);
   }
   expected += " (" + std::string(signal.description) + ")";
-  return expected;
+  return Error{expected};
 }
 
 void OutputChangeLog::record(std::string_view signal, int32_t level) {
@@ -87,28 +87,21 @@ std::optional<double> parse_number(std::string_view text) {
   return value;
 }
 
-std::optional<SignalAssignment> parse_signal_assignment(std::span<const SignalInfo> signals, std::string_view text,
-                                                        std::string& error) {
+Result<SignalAssignment> parse_signal_assignment(std::span<const SignalInfo> signals, std::string_view text) {
   const size_t equals = text.find('=');
-  if (equals == std::string_view::npos) {
-    error = "expected SIGNAL=VALUE, got \"" + std::string(text) + "\"";
-    return std::nullopt;
-  }
+  if (equals == std::string_view::npos) return Error{"expected SIGNAL=VALUE, got \"" + std::string(text) + "\""};
   const std::string_view name = text.substr(0, equals);
   const std::string_view value_text = text.substr(equals + 1);
   const SignalInfo* signal = find_signal(signals, name);
   if (signal == nullptr) {
-    error = "unknown signal \"" + std::string(name) + "\" (known: " + signal_names(signals) + ")";
-    return std::nullopt;
+    return Error{"unknown signal \"" + std::string(name) + "\" (known: " + signal_names(signals) + ")"};
   }
   const std::optional<double> value = parse_number(value_text);
   if (!value) {
-    error = "value of " + std::string(signal->name) + " is not a number: \"" + std::string(value_text) + "\"";
-    return std::nullopt;
+    return Error{"value of " + std::string(signal->name) + " is not a number: \"" + std::string(value_text) + "\""};
   }
-  if (std::string problem = check_signal_value(*signal, *value); !problem.empty()) {
-    error = problem + ", got " + std::string(value_text);
-    return std::nullopt;
+  if (const Result<void> acceptable = check_signal_value(*signal, *value); !acceptable) {
+    return Error{acceptable.error() + ", got " + std::string(value_text)};
   }
   return SignalAssignment{signal, *value};
 }

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "types/result.h"
+
 namespace motwin::sim {
 
 struct SignalInfo {
@@ -83,9 +85,9 @@ bool same_signal_name(std::string_view a, std::string_view b);
 // Case-insensitive lookup; returns nullptr for an unknown name.
 const SignalInfo* find_signal(std::span<const SignalInfo> signals, std::string_view name);
 
-// Empty when `value` is acceptable for `signal`, otherwise what was expected, for example
+// Success when `value` is acceptable for `signal`, otherwise what was expected, for example
 // "GPI0 takes 0 or 1" or "VSUPPLY takes 0 to 100 (supply voltage in volts)".
-std::string check_signal_value(const SignalInfo& signal, double value);
+Result<void> check_signal_value(const SignalInfo& signal, double value);
 
 // `first` followed by `second`: a board's table made of its I/O's signals and the motor side's.
 std::vector<SignalInfo> concat_signals(std::span<const SignalInfo> first, std::span<const SignalInfo> second);
@@ -101,8 +103,7 @@ struct SignalAssignment {
   double value = 0;
 };
 
-// Parses "NAME=VALUE" (as given to --set). On failure returns nullopt and sets `error`.
-std::optional<SignalAssignment> parse_signal_assignment(std::span<const SignalInfo> signals, std::string_view text,
-                                                        std::string& error);
+// Parses "NAME=VALUE" (as given to --set): the assignment, or what is wrong with it.
+Result<SignalAssignment> parse_signal_assignment(std::span<const SignalInfo> signals, std::string_view text);
 
 }  // namespace motwin::sim

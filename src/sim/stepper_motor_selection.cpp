@@ -40,13 +40,14 @@ std::string number_text(double value) {
 
 // The plant integrates the rotor explicitly: a stiff, light rotor would diverge. Names the key
 // that usually needs changing (the inertia) with the smallest value this motor allows.
-std::string stability_error(const StepperMotorDescription& motor) {
+Result<void> check_stability(const StepperMotorDescription& motor) {
   const double sub_step_s = StepperPlant::kBoardTickS / StepperPlant::kDefaultSubSteps;
   if (StepperPlant::step_number(motor, sub_step_s) <= StepperPlant::kStableStepNumber) return {};
-  return "\"rotor_inertia_kg_m2\" must be at least " + number_text(StepperPlant::min_stable_inertia_kg_m2(motor, sub_step_s)) +
-         " for this torque constant, detent torque, viscous friction and step count (the simulation's " +
-         number_text(sub_step_s * 1e6) + " us steps would diverge; " + number_text(StepperPlant::kStabilityPeakCurrentA) +
-         " A peak assumed)";
+  return Error{"\"rotor_inertia_kg_m2\" must be at least " +
+               number_text(StepperPlant::min_stable_inertia_kg_m2(motor, sub_step_s)) +
+               " for this torque constant, detent torque, viscous friction and step count (the simulation's " +
+               number_text(sub_step_s * 1e6) + " us steps would diverge; " +
+               number_text(StepperPlant::kStabilityPeakCurrentA) + " A peak assumed)"};
 }
 
 std::string preset_list() {
@@ -65,19 +66,15 @@ std::optional<StepperMotorDescription> stepper_motor_preset(std::string_view nam
   return std::nullopt;
 }
 
-StepperMotorChoice parse_stepper_motor_description(std::string_view json_text, std::string_view source_name) {
-  StepperMotorChoice result;
+Result<StepperMotorDescription> parse_stepper_motor_description(std::string_view json_text,
+                                                                std::string_view source_name) {
   const std::string prefix = std::string(source_name) + ": ";
   const Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
-  if (document.is_discarded() || !document.is_object()) {
-    result.error = prefix + "expected a JSON object";
-    return result;
-  }
+  if (document.is_discarded() || !document.is_object()) return Error{prefix + "expected a JSON object"};
   std::string base = "nema23";
   if (auto it = document.find("base"); it != document.end()) {
     if (!it->is_string() || !stepper_motor_preset(it->get<std::string>())) {
-      result.error = prefix + "\"base\" must be a preset name (nema17, nema23)";
-      return result;
+      return Error{prefix + "\"base\" must be a preset name (nema17, nema23)"};
     }
     base = it->get<std::string>();
   }
@@ -86,10 +83,7 @@ StepperMotorChoice parse_stepper_motor_description(std::string_view json_text, s
   for (const auto& [key, value] : document.items()) {
     if (key == "base") continue;
     if (key == "name") {
-      if (!value.is_string()) {
-        result.error = prefix + "\"name\" must be a string";
-        return result;
-      }
+      if (!value.is_string()) return Error{prefix + "\"name\" must be a string"};
       motor.name = value.get<std::string>();
       continue;
     }
@@ -97,8 +91,7 @@ StepperMotorChoice parse_stepper_motor_description(std::string_view json_text, s
       // Whole electrical periods (4 full steps) per revolution.
       if (!value.is_number_integer() || value.get<int64_t>() < 4 || value.get<int64_t>() > 4000 ||
           value.get<int64_t>() % 4 != 0) {
-        result.error = prefix + "\"full_steps_per_revolution\" must be a multiple of 4 from 4 to 4000";
-        return result;
+        return Error{prefix + "\"full_steps_per_revolution\" must be a multiple of 4 from 4 to 4000"};
       }
       motor.full_steps_per_revolution = static_cast<int>(value.get<int64_t>());
       continue;
@@ -107,43 +100,32 @@ StepperMotorChoice parse_stepper_motor_description(std::string_view json_text, s
     for (const NumberField& candidate : kNumberFields) {
       if (key == candidate.key) field = &candidate;
     }
-    if (field == nullptr) {
-      result.error = prefix + "unknown key \"" + key + "\"";
-      return result;
-    }
+    if (field == nullptr) return Error{prefix + "unknown key \"" + key + "\""};
     const double number = value.is_number() ? value.get<double>() : -1.0;
     if (!std::isfinite(number) || number < field->min || number > field->max) {
-      result.error = prefix + "\"" + key + "\" must be a number from " + number_text(field->min) + " to " +
-                     number_text(field->max);
-      return result;
+      return Error{prefix + "\"" + key + "\" must be a number from " + number_text(field->min) + " to " +
+                   number_text(field->max)};
     }
     motor.*(field->field) = number;
   }
-  if (std::string unstable = stability_error(motor); !unstable.empty()) {
-    result.error = prefix + unstable;
-    return result;
-  }
-  result.motor = motor;
-  return result;
+  if (const Result<void> stable = check_stability(motor); !stable) return stable.error_with_context(prefix);
+  return motor;
 }
 
-StepperMotorChoice resolve_stepper_motor(std::string_view name_or_path) {
-  StepperMotorChoice result;
-  if (name_or_path.empty() || name_or_path == "ideal") return result;
-  if (auto preset = stepper_motor_preset(name_or_path)) {
-    result.motor = std::move(preset);
-    return result;
-  }
+Result<StepperMotorChoice> resolve_stepper_motor(std::string_view name_or_path) {
+  if (name_or_path.empty() || name_or_path == "ideal") return StepperMotorChoice{};
+  if (std::optional<StepperMotorDescription> preset = stepper_motor_preset(name_or_path)) return preset;
   const std::string path(name_or_path);
   std::ifstream file(path);
   if (!file) {
-    result.error =
-        "unknown stepper motor \"" + path + "\" (expected " + preset_list() + " or a .json stepper description)";
-    return result;
+    return Error{"unknown stepper motor \"" + path + "\" (expected " + preset_list() +
+                 " or a .json stepper description)"};
   }
   std::ostringstream text;
   text << file.rdbuf();
-  return parse_stepper_motor_description(text.str(), path);
+  Result<StepperMotorDescription> described = parse_stepper_motor_description(text.str(), path);
+  if (!described) return Error{described.error()};
+  return StepperMotorChoice{std::move(*described)};
 }
 
 namespace {
@@ -156,17 +138,12 @@ std::string_view trimmed(std::string_view text) {
 
 }  // namespace
 
-StepperMotorChoices resolve_stepper_motors(std::string_view list, size_t axis_count) {
-  StepperMotorChoices result;
+Result<std::vector<StepperMotorChoice>> resolve_stepper_motors(std::string_view list, size_t axis_count) {
   if (list.find(',') == std::string_view::npos) {
     // One motor for all axes, as before per-axis lists (also "" = ideal).
-    StepperMotorChoice single = resolve_stepper_motor(trimmed(list));
-    if (!single.error.empty()) {
-      result.error = std::move(single.error);
-      return result;
-    }
-    result.motors.assign(axis_count, single.motor);
-    return result;
+    Result<StepperMotorChoice> single = resolve_stepper_motor(trimmed(list));
+    if (!single) return Error{single.error()};
+    return std::vector<StepperMotorChoice>(axis_count, *single);
   }
   std::vector<std::string_view> items;
   for (size_t start = 0;;) {
@@ -176,26 +153,21 @@ StepperMotorChoices resolve_stepper_motors(std::string_view list, size_t axis_co
     start = comma + 1;
   }
   if (items.size() != axis_count) {
-    result.error = "--motor \"" + std::string(list) + "\" names " + std::to_string(items.size()) + " motors for " +
-                   std::to_string(axis_count) + " axes (give one motor for all axes, or one per axis separated by commas)";
-    return result;
+    return Error{"--motor \"" + std::string(list) + "\" names " + std::to_string(items.size()) + " motors for " +
+                 std::to_string(axis_count) +
+                 " axes (give one motor for all axes, or one per axis separated by commas)"};
   }
+  std::vector<StepperMotorChoice> motors;
   for (size_t axis = 0; axis < items.size(); ++axis) {
     const std::string prefix = "motor of axis " + std::to_string(axis) + ": ";
     if (items[axis].empty()) {
-      result.error = prefix + "empty name (expected " + preset_list() + " or a .json stepper description)";
-      result.motors.clear();
-      return result;
+      return Error{prefix + "empty name (expected " + preset_list() + " or a .json stepper description)"};
     }
-    StepperMotorChoice choice = resolve_stepper_motor(items[axis]);
-    if (!choice.error.empty()) {
-      result.error = prefix + choice.error;
-      result.motors.clear();
-      return result;
-    }
-    result.motors.push_back(std::move(choice.motor));
+    Result<StepperMotorChoice> choice = resolve_stepper_motor(items[axis]);
+    if (!choice) return choice.error_with_context(prefix);
+    motors.push_back(std::move(*choice));
   }
-  return result;
+  return motors;
 }
 
 }  // namespace motwin::sim

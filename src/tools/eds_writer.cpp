@@ -171,8 +171,10 @@ std::string write_eds(const CanopenIdentity& identity, const CanopenDictionaryVi
   return eds.take();
 }
 
-std::optional<std::string> write_module_eds(const host::ModuleDescriptor& module, std::optional<uint8_t> node_id) {
-  if (module.canopen == nullptr) return std::nullopt;
+Result<std::string> write_module_eds(const host::ModuleDescriptor& module, std::optional<uint8_t> node_id) {
+  if (module.canopen == nullptr) {
+    return Error{"module \"" + std::string(module.name) + "\" has no CANopen object dictionary"};
+  }
   return write_eds(module.canopen->identity, module.canopen->dictionary(), node_id);
 }
 

@@ -11,6 +11,7 @@
 
 #include "host/canopen_dictionary_view.h"
 #include "host/module_descriptor.h"
+#include "types/result.h"
 
 namespace motwin::tools {
 
@@ -18,7 +19,7 @@ namespace motwin::tools {
 std::string write_eds(const host::CanopenIdentity& identity, const host::CanopenDictionaryView& dictionary,
                       std::optional<uint8_t> node_id = {});
 
-// The EDS of a module, or nullopt for a module without a CANopen dictionary.
-std::optional<std::string> write_module_eds(const host::ModuleDescriptor& module, std::optional<uint8_t> node_id = {});
+// The EDS of a module; an error for a module without a CANopen dictionary.
+Result<std::string> write_module_eds(const host::ModuleDescriptor& module, std::optional<uint8_t> node_id = {});
 
 }  // namespace motwin::tools

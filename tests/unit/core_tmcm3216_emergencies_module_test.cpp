@@ -226,8 +226,8 @@ TEST(Tmcm3216EmergenciesModule, bus_off_on_the_virtual_bus_stops_the_axis_and_81
   options.node_id = 5;
   options.log = [](const std::string&) {};
   host::MakeModuleResult made = host::make_module("tmcm-3216", options);
-  ASSERT_TRUE(made.module) << made.error;
-  auto& module = static_cast<host::Tmcm3216VirtualModule&>(*made.module);
+  ASSERT_TRUE(made) << made.error();
+  auto& module = static_cast<host::Tmcm3216VirtualModule&>(**made);
   host::CanBus bus([&module] { return module.sim_time_us(); });
   bus.set_bit_rate(1'000'000);
   Listener master;

@@ -55,8 +55,8 @@ TEST(HostRuntimeBusyPoll, input_on_any_descriptor_opens_the_window_and_output_al
   options.node_id = 1;
   options.log = quiet;
   MakeModuleResult made = make_module("tmcm-3216", options);
-  ASSERT_TRUE(made.module) << made.error;
-  HostRuntime runtime(*made.module, Pacing::realtime());
+  ASSERT_TRUE(made) << made.error();
+  HostRuntime runtime(**made, Pacing::realtime());
   ASSERT_FALSE(runtime.has_tmcl_service());
   runtime.start();
   Pipe pipe;
@@ -88,14 +88,13 @@ TEST(HostRuntimeBusyPoll, input_on_any_descriptor_opens_the_window_and_output_al
 TEST(HostRuntimeBusyPoll, can_frames_from_a_socketcand_client_open_the_window_of_a_can_only_group) {
   std::vector<NodeSpec> specs;
   for (const char* text : {"tmcm-3216:node-id=1", "tmcm-1636"}) {
-    std::string error;
-    std::optional<NodeSpec> spec = parse_node_spec(text, specs.size() + 1, error);
-    ASSERT_TRUE(spec) << error;
+    const Result<NodeSpec> spec = parse_node_spec(text, specs.size() + 1);
+    ASSERT_TRUE(spec) << spec.error();
     specs.push_back(*spec);
   }
-  ModuleGroup::MakeResult made = ModuleGroup::make(specs, std::nullopt, quiet);
-  ASSERT_TRUE(made.group) << made.error;
-  ModuleGroup& group = *made.group;
+  Result<std::unique_ptr<ModuleGroup>> made = ModuleGroup::make(specs, std::nullopt, quiet);
+  ASSERT_TRUE(made) << made.error();
+  ModuleGroup& group = **made;
   HostRuntime runtime(group, Pacing::realtime());
   ASSERT_FALSE(runtime.has_tmcl_service());
   CanBus bus([&group] { return group.sim_time_us(); });

@@ -149,8 +149,8 @@ TEST(CanBusBitRate, a_tmcl_module_reports_gp_69_from_its_last_power_up) {
   ModuleOptions options;
   options.log = [](const std::string&) {};
   MakeModuleResult made = make_module("tmcm-1636", options);
-  ASSERT_TRUE(made.module) << made.error;
-  VirtualModule& module = *made.module;
+  ASSERT_TRUE(made) << made.error();
+  VirtualModule& module = **made;
   CanBus bus([&module] { return module.sim_time_us(); });
   bus.set_bit_rate(1'000'000);
   RatedNode host;
@@ -178,8 +178,8 @@ class Tmcm3216OnBus : public ::testing::Test {
     options.node_id = 5;
     options.log = [](const std::string&) {};
     MakeModuleResult made = make_module("tmcm-3216", options);
-    ASSERT_TRUE(made.module) << made.error;
-    module = std::move(made.module);
+    ASSERT_TRUE(made) << made.error();
+    module = std::move(*made);
     bus.set_clock([this] { return module->sim_time_us(); });
     bus.set_bit_rate(1'000'000);
     master_id = bus.attach(master);

@@ -214,8 +214,8 @@ TEST(CanBus, frames_sent_within_one_batch_of_ticks_carry_their_own_tick_time) {
   options.node_id = 4;
   options.log = [](const std::string&) {};
   MakeModuleResult made = make_module("tmcm-3216", options);
-  ASSERT_TRUE(made.module) << made.error;
-  VirtualModule& module = *made.module;
+  ASSERT_TRUE(made) << made.error();
+  VirtualModule& module = **made;
   CanBus bus([&module] { return module.sim_time_us(); });
   Recorder master;
   const CanBus::EndpointId master_id = bus.attach(master);
@@ -241,8 +241,8 @@ TEST(SocketcandServer, serves_an_sdo_exchange_and_never_echoes) {
   options.node_id = 3;
   options.log = [](const std::string&) {};
   MakeModuleResult made = make_module("tmcm-3216", options);
-  ASSERT_TRUE(made.module) << made.error;
-  VirtualModule& module = *made.module;
+  ASSERT_TRUE(made) << made.error();
+  VirtualModule& module = **made;
   EXPECT_FALSE(module.has_tmcl());
   ASSERT_NE(module.can_node(), nullptr);
   EventLoop loop;

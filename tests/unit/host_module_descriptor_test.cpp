@@ -83,12 +83,12 @@ TEST(ModuleDescriptors, each_motor_choice_makes_the_module_the_descriptor_descri
       ModuleOptions options;
       options.motor = std::string(motor);
       const MakeModuleResult made = descriptor.make(options);
-      ASSERT_NE(made.module, nullptr) << made.error;
-      const VirtualModule& module = *made.module;
+      ASSERT_TRUE(made) << made.error();
+      const VirtualModule& module = **made;
       EXPECT_EQ(module.name(), descriptor.name);
       EXPECT_EQ(module.firmware_version(), descriptor.firmware);
       EXPECT_EQ(module.has_tmcl(), descriptor.endpoints.has_tmcl());
-      EXPECT_EQ(made.module->can_node() != nullptr, descriptor.endpoints.has_can());
+      EXPECT_EQ((*made)->can_node() != nullptr, descriptor.endpoints.has_can());
     }
   }
 }
@@ -117,7 +117,9 @@ TEST(ModuleDescriptors, eds_writes_canopen_modules_and_names_them_for_the_others
       EXPECT_EQ(eds.exit_status, 0) << eds.output;
       EXPECT_TRUE(eds.output.starts_with("[FileInfo]\n"));
       EXPECT_TRUE(contains(eds.output, "\nProductName=" + std::string(module.canopen->identity.product_name) + "\n"));
-      EXPECT_EQ(eds.output, tools::write_module_eds(module).value_or(""));
+      const Result<std::string> written = tools::write_module_eds(module);
+      ASSERT_TRUE(written) << written.error();
+      EXPECT_EQ(eds.output, *written);
     } else {
       EXPECT_EQ(eds.exit_status, 2);
       EXPECT_EQ(eds.output, "motwin: error: module \"" + name_of(module) +
@@ -259,8 +261,8 @@ TEST(ModuleDescriptors, a_new_canopen_row_gets_an_object_listing_and_an_eds_from
   EXPECT_TRUE(table.starts_with("fake-2 objects\n\nCommunication profile area (1000..1FFF)\n")) << table;
   EXPECT_TRUE(contains(table, "\n\nDevice profile area (6000..9FFF)\n")) << table;
 
-  const std::optional<std::string> eds = tools::write_module_eds(fake, 3);
-  ASSERT_TRUE(eds);
+  const Result<std::string> eds = tools::write_module_eds(fake, 3);
+  ASSERT_TRUE(eds) << eds.error();
   for (const char* line : {"FileName=FAKE-2.eds", "VendorNumber=0x1234", "ProductNumber=2", "RevisionNumber=0x00010000",
                            "BaudRate_10=0", "BaudRate_125=1", "BaudRate_500=0", "BaudRate_1000=1", "NrOfRXPDO=1",
                            "NrOfTXPDO=2", "LSS_Supported=0", "NodeID=3", "[MandatoryObjects]\nSupportedObjects=1\n1=0x1000",

@@ -38,14 +38,14 @@ TEST(ModuleRegistry, knows_the_tmcm_1636_and_refuses_unknown_names) {
   // 11 I/O signals (GPI0..REF_H) and 8 of the motor (LOAD_TORQUE..HALL_FAULT).
   EXPECT_EQ(find_module("tmcm-1636")->input_signals().size(), 19u);
   const MakeModuleResult unknown = make_module("tmcm-9999", {});
-  EXPECT_FALSE(unknown.module);
-  EXPECT_EQ(unknown.error, "unknown module \"tmcm-9999\" (available: tmcm-1636, tmcm-142, tmcm-3216)");
+  EXPECT_FALSE(unknown);
+  EXPECT_EQ(unknown.error(), "unknown module \"tmcm-9999\" (available: tmcm-1636, tmcm-142, tmcm-3216)");
 }
 
 TEST(VirtualModule, a_tmcm_1636_in_memory_describes_itself) {
   MakeModuleResult made = make_quiet();
-  ASSERT_TRUE(made.module) << made.error;
-  VirtualModule& module = *made.module;
+  ASSERT_TRUE(made) << made.error();
+  VirtualModule& module = **made;
   EXPECT_EQ(module.name(), "tmcm-1636");
   EXPECT_EQ(module.firmware_version(), "1636V109");
   EXPECT_EQ(module.tick_period_us(), 50u);
@@ -63,40 +63,40 @@ TEST(VirtualModule, stores_go_to_the_image_file_and_survive_a_restart) {
   options.state_dir = scratch.path();
   {
     MakeModuleResult made = make_quiet(options);
-    ASSERT_TRUE(made.module) << made.error;
-    EXPECT_EQ(made.module->nvm_location(), (scratch.path() / "tmcm-1636.eeprom").string());
-    EXPECT_EQ(execute(*made.module, kSap, 43, 0, 3210).status, tmcl::Status::kOk);
-    EXPECT_EQ(execute(*made.module, kStap, 43, 0, 0).status, tmcl::Status::kOk);
+    ASSERT_TRUE(made) << made.error();
+    EXPECT_EQ((*made)->nvm_location(), (scratch.path() / "tmcm-1636.eeprom").string());
+    EXPECT_EQ(execute(**made, kSap, 43, 0, 3210).status, tmcl::Status::kOk);
+    EXPECT_EQ(execute(**made, kStap, 43, 0, 0).status, tmcl::Status::kOk);
   }
   MakeModuleResult restarted = make_quiet(options);
-  ASSERT_TRUE(restarted.module) << restarted.error;
-  EXPECT_EQ(read(*restarted.module, kGap, 43, 0), 3210);
+  ASSERT_TRUE(restarted) << restarted.error();
+  EXPECT_EQ(read(**restarted, kGap, 43, 0), 3210);
 }
 
 TEST(VirtualModule, initial_inputs_are_set_before_power_up) {
   ModuleOptions options;
   options.initial_inputs = {{"VSUPPLY", 30.0}, {"GPI1", 1}};
   MakeModuleResult made = make_quiet(options);
-  ASSERT_TRUE(made.module);
-  EXPECT_EQ(read(*made.module, kGio, 2, 1), modules::tmcm1636::supply_adc_from_millivolt(30000));  // ADC_VM
-  EXPECT_EQ(read(*made.module, kGio, 1, 0), 1);
+  ASSERT_TRUE(made);
+  EXPECT_EQ(read(**made, kGio, 2, 1), modules::tmcm1636::supply_adc_from_millivolt(30000));  // ADC_VM
+  EXPECT_EQ(read(**made, kGio, 1, 0), 1);
 }
 
 TEST(HostRuntime, a_scenario_event_lands_on_the_first_tick_at_or_after_its_time) {
   MakeModuleResult made = make_quiet();
-  ASSERT_TRUE(made.module);
-  HostRuntime runtime(*made.module, Pacing::fast());
-  const sim::ScenarioParseResult scenario =
-      sim::parse_scenario("0.50001 GPI0 1\n0 GPI2 1\n", "t.scn", made.module->signals().input_signals());
+  ASSERT_TRUE(made);
+  HostRuntime runtime(**made, Pacing::fast());
+  const Result<std::vector<sim::ScenarioEvent>> scenario =
+      sim::parse_scenario("0.50001 GPI0 1\n0 GPI2 1\n", "t.scn", (*made)->signals().input_signals());
   ASSERT_TRUE(scenario.ok());
-  runtime.set_scenario(scenario.events);
+  runtime.set_scenario(*scenario);
   runtime.start();
-  EXPECT_EQ(read(*made.module, kGio, 2, 0), 1);  // time 0: applied at start
+  EXPECT_EQ(read(**made, kGio, 2, 0), 1);  // time 0: applied at start
   runtime.advance_ticks(10'000);                 // up to 0.5 s: one batch, split at the event
   EXPECT_EQ(runtime.sim_time_us(), 500'000u);
-  EXPECT_EQ(read(*made.module, kGio, 0, 0), 0);
+  EXPECT_EQ(read(**made, kGio, 0, 0), 0);
   runtime.advance_ticks(1);  // the event (0.50001 s) applies before the tick starting at 0.50005 s
-  EXPECT_EQ(read(*made.module, kGio, 0, 0), 1);
+  EXPECT_EQ(read(**made, kGio, 0, 0), 1);
   EXPECT_TRUE(runtime.scenario()->finished());
 }
 
@@ -104,22 +104,21 @@ TEST(HostRuntime, a_scenario_event_lands_on_the_first_tick_at_or_after_its_time)
 TEST(HostRuntime, trajectories_do_not_depend_on_batching) {
   auto run = [](uint64_t batch_ticks) {
     MakeModuleResult made = make_quiet();
-    HostRuntime runtime(*made.module, Pacing::fast());
-    runtime.set_scenario(sim::parse_scenario("0.0123 VSUPPLY 12\n0.0371 VSUPPLY 48\n", "t.scn",
-                                             made.module->signals().input_signals())
-                             .events);
+    HostRuntime runtime(**made, Pacing::fast());
+    runtime.set_scenario(
+        *sim::parse_scenario("0.0123 VSUPPLY 12\n0.0371 VSUPPLY 48\n", "t.scn", (*made)->signals().input_signals()));
     runtime.start();
-    EXPECT_EQ(execute(*made.module, kRor, 0, 0, 1500).status, tmcl::Status::kOk);
+    EXPECT_EQ(execute(**made, kRor, 0, 0, 1500).status, tmcl::Status::kOk);
     std::vector<int32_t> samples;
     for (uint64_t done = 0; done < 2000;) {
       runtime.advance_ticks(batch_ticks);
       done += batch_ticks;
       if (done % 400 == 0) {
-        for (uint8_t parameter : {41, 42, 51, 52}) samples.push_back(read(*made.module, kGap, parameter, 0));
+        for (uint8_t parameter : {41, 42, 51, 52}) samples.push_back(read(**made, kGap, parameter, 0));
       }
     }
-    samples.push_back(read(*made.module, kGap, 42, 0));  // actual velocity
-    samples.push_back(read(*made.module, kGap, 41, 0));  // ramp velocity
+    samples.push_back(read(**made, kGap, 42, 0));  // actual velocity
+    samples.push_back(read(**made, kGap, 41, 0));  // ramp velocity
     return samples;
   };
   const std::vector<int32_t> one_by_one = run(1);
@@ -130,7 +129,7 @@ TEST(HostRuntime, trajectories_do_not_depend_on_batching) {
 
 TEST(HostRuntime, realtime_pacing_follows_the_wall_clock) {
   MakeModuleResult made = make_quiet();
-  HostRuntime runtime(*made.module, Pacing::realtime());
+  HostRuntime runtime(**made, Pacing::realtime());
   runtime.start();
   const uint64_t start_us = monotonic_now_us();
   while (monotonic_now_us() - start_us < 50'000) runtime.step(10'000);

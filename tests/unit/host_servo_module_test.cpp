@@ -36,37 +36,37 @@ MakeModuleResult make_with_motor(const std::string& motor, std::optional<std::fi
   return make_module("tmcm-1636", options);
 }
 
-Tmcm1636VirtualModule& tmcm1636(MakeModuleResult& made) { return static_cast<Tmcm1636VirtualModule&>(*made.module); }
+Tmcm1636VirtualModule& tmcm1636(MakeModuleResult& made) { return static_cast<Tmcm1636VirtualModule&>(**made); }
 
 TEST(ServoModule, the_default_motor_is_ideal) {
   MakeModuleResult made = make_with_motor("");
-  ASSERT_TRUE(made.module) << made.error;
+  ASSERT_TRUE(made) << made.error();
   EXPECT_EQ(tmcm1636(made).board().plant(), nullptr);
-  EXPECT_EQ(gap(*made.module, 14), 0) << "factory motor type";
+  EXPECT_EQ(gap(**made, 14), 0) << "factory motor type";
 }
 
 TEST(ServoModule, a_preset_moves_out_of_the_box_with_its_startup_settings) {
   MakeModuleResult made = make_with_motor("default-24v");
-  ASSERT_TRUE(made.module) << made.error;
+  ASSERT_TRUE(made) << made.error();
   ASSERT_NE(tmcm1636(made).board().plant(), nullptr);
-  EXPECT_EQ(gap(*made.module, 14), 3);
-  EXPECT_EQ(gap(*made.module, 15), 2);
-  EXPECT_EQ(gap(*made.module, 100), 4096);
-  EXPECT_EQ(execute(*made.module, kRor, 0, 1000).status, tmcl::Status::kOk);
-  made.module->run_ticks(20'000);
-  EXPECT_NEAR(gap(*made.module, 42), 1000, 10);
-  EXPECT_NEAR(*made.module->signals().read_signal("SPEED_RPM"), 1000.0, 10.0);
-  EXPECT_EQ(gap(*made.module, 220), 240) << "AP 220 reads the bus";
+  EXPECT_EQ(gap(**made, 14), 3);
+  EXPECT_EQ(gap(**made, 15), 2);
+  EXPECT_EQ(gap(**made, 100), 4096);
+  EXPECT_EQ(execute(**made, kRor, 0, 1000).status, tmcl::Status::kOk);
+  (*made)->run_ticks(20'000);
+  EXPECT_NEAR(gap(**made, 42), 1000, 10);
+  EXPECT_NEAR(*(*made)->signals().read_signal("SPEED_RPM"), 1000.0, 10.0);
+  EXPECT_EQ(gap(**made, 220), 240) << "AP 220 reads the bus";
 }
 
 TEST(ServoModule, an_unknown_motor_is_refused_before_any_file_is_touched) {
   testing::ScratchDirectory scratch;
   MakeModuleResult made = make_with_motor("turbo", scratch.path() / "state");
-  EXPECT_FALSE(made.module);
-  EXPECT_NE(made.error.find("unknown motor \"turbo\""), std::string::npos) << made.error;
+  EXPECT_FALSE(made);
+  EXPECT_NE(made.error().find("unknown motor \"turbo\""), std::string::npos) << made.error();
   EXPECT_FALSE(std::filesystem::exists(scratch.path() / "state"));
   MakeModuleResult missing = make_with_motor((scratch.path() / "none.json").string());
-  EXPECT_NE(missing.error.find("cannot read motor description"), std::string::npos) << missing.error;
+  EXPECT_NE(missing.error().find("cannot read motor description"), std::string::npos) << missing.error();
 }
 
 TEST(ServoModule, a_motor_file_is_loaded) {
@@ -74,9 +74,9 @@ TEST(ServoModule, a_motor_file_is_loaded) {
   const std::string path = (scratch.path() / "m.json").string();
   std::ofstream(path) << sim::motor_description_json(*sim::motor_preset("large-48v"));
   MakeModuleResult made = make_with_motor(path);
-  ASSERT_TRUE(made.module) << made.error;
-  EXPECT_EQ(gap(*made.module, 10), 7);
-  EXPECT_EQ(gap(*made.module, 220), 480) << "48 V supply";
+  ASSERT_TRUE(made) << made.error();
+  EXPECT_EQ(gap(**made, 10), 7);
+  EXPECT_EQ(gap(**made, 220), 480) << "48 V supply";
 }
 
 // The start-up settings go into new images only; an existing image is the user's.
@@ -84,15 +84,15 @@ TEST(ServoModule, an_existing_image_keeps_its_settings) {
   testing::ScratchDirectory scratch;
   {
     MakeModuleResult ideal = make_with_motor("ideal", scratch.path());
-    ASSERT_TRUE(ideal.module);
-    EXPECT_EQ(execute(*ideal.module, kSap, 43, 3000).status, tmcl::Status::kOk);
-    EXPECT_EQ(execute(*ideal.module, kStap, 43, 0).status, tmcl::Status::kOk);
+    ASSERT_TRUE(ideal);
+    EXPECT_EQ(execute(**ideal, kSap, 43, 3000).status, tmcl::Status::kOk);
+    EXPECT_EQ(execute(**ideal, kStap, 43, 0).status, tmcl::Status::kOk);
   }
   std::vector<std::string> log;
   MakeModuleResult made = make_with_motor("default-24v", scratch.path(), &log);
-  ASSERT_TRUE(made.module);
-  EXPECT_EQ(gap(*made.module, 14), 0) << "the image says no motor";
-  EXPECT_EQ(gap(*made.module, 43), 3000);
+  ASSERT_TRUE(made);
+  EXPECT_EQ(gap(**made, 14), 0) << "the image says no motor";
+  EXPECT_EQ(gap(**made, 43), 3000);
   ASSERT_EQ(log.size(), 1u);
   EXPECT_NE(log[0].find("start-up settings go into new images only"), std::string::npos) << log[0];
 }
@@ -102,22 +102,22 @@ TEST(ServoModule, an_existing_image_keeps_its_settings) {
 TEST(ServoModule, a_scenario_load_step_is_rejected_and_runs_are_bit_identical) {
   auto run = [](uint64_t batch) {
     MakeModuleResult made = make_with_motor("default-24v");
-    HostRuntime runtime(*made.module, Pacing::fast());
-    const sim::ScenarioParseResult scenario = sim::parse_scenario(
-        "2.0 LOAD_TORQUE 0.025\n2.5 REF_R_AT 1e5\n3.0 VSUPPLY 22\n", "step.scn", made.module->signals().input_signals());
-    EXPECT_TRUE(scenario.ok()) << scenario.error;
-    runtime.set_scenario(scenario.events);
+    HostRuntime runtime(**made, Pacing::fast());
+    const Result<std::vector<sim::ScenarioEvent>> scenario = sim::parse_scenario(
+        "2.0 LOAD_TORQUE 0.025\n2.5 REF_R_AT 1e5\n3.0 VSUPPLY 22\n", "step.scn", (*made)->signals().input_signals());
+    EXPECT_TRUE(scenario.ok()) << scenario.error();
+    runtime.set_scenario(*scenario);
     runtime.start();
-    EXPECT_EQ(execute(*made.module, kSap, 44, 20000).status, tmcl::Status::kOk);
-    EXPECT_EQ(execute(*made.module, kRor, 0, 1500).status, tmcl::Status::kOk);
+    EXPECT_EQ(execute(**made, kSap, 44, 20000).status, tmcl::Status::kOk);
+    EXPECT_EQ(execute(**made, kRor, 0, 1500).status, tmcl::Status::kOk);
     std::vector<double> trace;
     double dip = 1e9;
     for (uint64_t done = 0; done < 80'000; done += batch) {
       runtime.advance_ticks(batch);
-      const double speed = *made.module->signals().read_signal("SPEED_RPM");
+      const double speed = *(*made)->signals().read_signal("SPEED_RPM");
       if (done > 40'000) dip = std::min(dip, speed);
       trace.push_back(speed);
-      trace.push_back(*made.module->signals().read_signal("VBUS"));
+      trace.push_back(*(*made)->signals().read_signal("VBUS"));
     }
     trace.push_back(dip);
     return trace;

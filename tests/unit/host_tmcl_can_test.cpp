@@ -48,8 +48,8 @@ std::unique_ptr<VirtualModule> make_1636() {
   ModuleOptions options;
   options.log = [](const std::string&) {};
   MakeModuleResult made = make_module("tmcm-1636", options);
-  EXPECT_TRUE(made.module) << made.error;
-  return std::move(made.module);
+  EXPECT_TRUE(made) << made.error();
+  return std::move(*made);
 }
 
 TEST(TmclCanLink, seven_byte_request_gets_a_seven_byte_reply_on_the_send_id) {
@@ -274,35 +274,34 @@ TEST(CanBusLoad, without_a_bit_rate_frames_take_no_time) {
 }
 
 TEST(ModuleGroup, parses_node_options) {
-  std::string error;
-  const std::optional<NodeSpec> plain = parse_node_spec("tmcm-1636", 3, error);
-  ASSERT_TRUE(plain) << error;
+  const Result<NodeSpec> plain = parse_node_spec("tmcm-1636", 3);
+  ASSERT_TRUE(plain) << plain.error();
   EXPECT_EQ(plain->name, "tmcm-1636-3");
-  const std::optional<NodeSpec> full = parse_node_spec("tmcm-3216:node-id=5,name=left", 1, error);
-  ASSERT_TRUE(full) << error;
+  const Result<NodeSpec> full = parse_node_spec("tmcm-3216:node-id=5,name=left", 1);
+  ASSERT_TRUE(full) << full.error();
   EXPECT_EQ(full->node_id, 5);
   EXPECT_EQ(full->name, "left");
-  const std::optional<NodeSpec> ids = parse_node_spec("tmcm-1636:receive-id=3,send-id=4", 1, error);
-  ASSERT_TRUE(ids) << error;
+  const Result<NodeSpec> ids = parse_node_spec("tmcm-1636:receive-id=3,send-id=4", 1);
+  ASSERT_TRUE(ids) << ids.error();
   EXPECT_EQ(ids->receive_id, 3);
   EXPECT_EQ(ids->send_id, 4);
-  EXPECT_FALSE(parse_node_spec("tmcm-9999", 1, error));
-  EXPECT_NE(error.find("unknown module"), std::string::npos);
-  EXPECT_FALSE(parse_node_spec("tmcm-3216:node-id=128", 1, error));
-  EXPECT_FALSE(parse_node_spec("tmcm-3216:colour=red", 1, error));
-  EXPECT_FALSE(parse_node_spec("tmcm-3216:name=../x", 1, error));
-  EXPECT_FALSE(parse_node_spec("tmcm-1636:receive-id=256", 1, error));
+  const Result<NodeSpec> unknown = parse_node_spec("tmcm-9999", 1);
+  EXPECT_FALSE(unknown);
+  EXPECT_NE(unknown.error().find("unknown module"), std::string::npos);
+  EXPECT_FALSE(parse_node_spec("tmcm-3216:node-id=128", 1));
+  EXPECT_FALSE(parse_node_spec("tmcm-3216:colour=red", 1));
+  EXPECT_FALSE(parse_node_spec("tmcm-3216:name=../x", 1));
+  EXPECT_FALSE(parse_node_spec("tmcm-1636:receive-id=256", 1));
 }
 
 TEST(ModuleGroup, members_share_one_clock_and_answer_only_their_own_ids) {
-  std::string error;
   std::vector<NodeSpec> specs;
   for (const char* text : {"tmcm-3216:node-id=1", "tmcm-3216:node-id=2", "tmcm-1636"}) {
-    specs.push_back(*parse_node_spec(text, specs.size() + 1, error));
+    specs.push_back(*parse_node_spec(text, specs.size() + 1));
   }
-  ModuleGroup::MakeResult made = ModuleGroup::make(specs, std::nullopt, [](const std::string&) {});
-  ASSERT_TRUE(made.group) << made.error;
-  ModuleGroup& group = *made.group;
+  Result<std::unique_ptr<ModuleGroup>> made = ModuleGroup::make(specs, std::nullopt, [](const std::string&) {});
+  ASSERT_TRUE(made) << made.error();
+  ModuleGroup& group = **made;
   EXPECT_EQ(group.tick_period_us(), 50u);
   group.run_ticks(40);  // 2 ms
   for (ModuleGroup::Member& member : group.members()) EXPECT_EQ(member.module->sim_time_us(), 2000u) << member.name;
@@ -320,11 +319,10 @@ TEST(ModuleGroup, members_share_one_clock_and_answer_only_their_own_ids) {
 }
 
 TEST(ModuleGroup, refuses_two_nodes_with_one_name) {
-  std::string error;
-  std::vector<NodeSpec> specs{*parse_node_spec("tmcm-3216:name=a", 1, error), *parse_node_spec("tmcm-1636:name=a", 2, error)};
-  ModuleGroup::MakeResult made = ModuleGroup::make(specs, std::nullopt, [](const std::string&) {});
-  EXPECT_FALSE(made.group);
-  EXPECT_NE(made.error.find("two nodes named \"a\""), std::string::npos) << made.error;
+  std::vector<NodeSpec> specs{*parse_node_spec("tmcm-3216:name=a", 1), *parse_node_spec("tmcm-1636:name=a", 2)};
+  Result<std::unique_ptr<ModuleGroup>> made = ModuleGroup::make(specs, std::nullopt, [](const std::string&) {});
+  EXPECT_FALSE(made);
+  EXPECT_NE(made.error().find("two nodes named \"a\""), std::string::npos) << made.error();
 }
 
 }  // namespace

@@ -34,8 +34,8 @@ class TmclServiceOrder : public ::testing::Test {
     ModuleOptions options;
     options.log = [](const std::string&) {};
     MakeModuleResult made = make_module("tmcm-1636", options);
-    ASSERT_TRUE(made.module) << made.error;
-    module_ = std::move(made.module);
+    ASSERT_TRUE(made) << made.error();
+    module_ = std::move(*made);
     service_ = std::make_unique<TmclHostService>(module_->engine(), loop_);
   }
   // Rounds of serving until nothing is left, as the host runtime does between its polls.

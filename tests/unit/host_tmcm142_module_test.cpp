@@ -24,7 +24,7 @@ constexpr int32_t kRev = 204800;
 
 struct Made {
   MakeModuleResult result;
-  Tmcm142VirtualModule& module() { return static_cast<Tmcm142VirtualModule&>(*result.module); }
+  Tmcm142VirtualModule& module() { return static_cast<Tmcm142VirtualModule&>(**result); }
 };
 
 Made make(const std::string& motor = "ideal", std::vector<InitialInput> inputs = {}) {
@@ -50,49 +50,49 @@ void run_until_reached(VirtualModule& module, uint64_t max_ms) {
 
 TEST(Tmcm142Module, the_default_motor_is_ideal_and_presets_and_files_are_steppers) {
   Made ideal = make("");
-  ASSERT_TRUE(ideal.result.module) << ideal.result.error;
-  EXPECT_EQ(ideal.result.module->firmware_version(), "142V1.06");
-  EXPECT_EQ(ideal.result.module->tick_period_us(), 50u);
+  ASSERT_TRUE(ideal.result) << ideal.result.error();
+  EXPECT_EQ((*ideal.result)->firmware_version(), "142V1.06");
+  EXPECT_EQ((*ideal.result)->tick_period_us(), 50u);
   EXPECT_EQ(ideal.module().board().plant(), nullptr);
   Made nema17 = make("nema17");
-  ASSERT_TRUE(nema17.result.module) << nema17.result.error;
+  ASSERT_TRUE(nema17.result) << nema17.result.error();
   ASSERT_NE(nema17.module().board().plant(), nullptr);
   EXPECT_DOUBLE_EQ(nema17.module().board().plant()->motor().rated_current_a, 1.5);
 
   Made servo_preset = make("default-24v");
-  EXPECT_FALSE(servo_preset.result.module);
-  EXPECT_NE(servo_preset.result.error.find("unknown stepper motor \"default-24v\""), std::string::npos)
-      << servo_preset.result.error;
+  EXPECT_FALSE(servo_preset.result);
+  EXPECT_NE(servo_preset.result.error().find("unknown stepper motor \"default-24v\""), std::string::npos)
+      << servo_preset.result.error();
 }
 
 TEST(Tmcm142Module, stepper_description_files_start_from_a_preset_and_check_every_key) {
-  const sim::StepperMotorChoice good = sim::parse_stepper_motor_description(
+  const Result<sim::StepperMotorDescription> good = sim::parse_stepper_motor_description(
       R"({"name": "my-motor", "base": "nema17", "rated_current_a": 2.0, "full_steps_per_revolution": 400})", "m.json");
-  ASSERT_TRUE(good.motor) << good.error;
-  EXPECT_EQ(good.motor->name, "my-motor");
-  EXPECT_DOUBLE_EQ(good.motor->rated_current_a, 2.0);
-  EXPECT_EQ(good.motor->full_steps_per_revolution, 400);
-  EXPECT_DOUBLE_EQ(good.motor->resistance_ohm, 1.5) << "from the nema17 base";
-  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"resistance": 1})", "m.json").error,
+  ASSERT_TRUE(good) << good.error();
+  EXPECT_EQ(good->name, "my-motor");
+  EXPECT_DOUBLE_EQ(good->rated_current_a, 2.0);
+  EXPECT_EQ(good->full_steps_per_revolution, 400);
+  EXPECT_DOUBLE_EQ(good->resistance_ohm, 1.5) << "from the nema17 base";
+  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"resistance": 1})", "m.json").error(),
             "m.json: unknown key \"resistance\"");
-  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"inductance_h": 0})", "m.json").error,
+  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"inductance_h": 0})", "m.json").error(),
             "m.json: \"inductance_h\" must be a number from 1e-06 to 10");
-  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"full_steps_per_revolution": 201})", "m.json").error,
+  EXPECT_EQ(sim::parse_stepper_motor_description(R"({"full_steps_per_revolution": 201})", "m.json").error(),
             "m.json: \"full_steps_per_revolution\" must be a multiple of 4 from 4 to 4000");
-  EXPECT_EQ(sim::parse_stepper_motor_description("[1]", "m.json").error, "m.json: expected a JSON object");
+  EXPECT_EQ(sim::parse_stepper_motor_description("[1]", "m.json").error(), "m.json: expected a JSON object");
   // A preset from a file is the ideal motor's counterpart of --motor nema23.
-  const sim::StepperMotorChoice preset = sim::resolve_stepper_motor("nema23");
-  ASSERT_TRUE(preset.motor);
-  EXPECT_EQ(preset.motor->name, "nema23");
-  EXPECT_FALSE(sim::resolve_stepper_motor("ideal").motor);
-  EXPECT_TRUE(sim::resolve_stepper_motor("ideal").error.empty());
+  const Result<sim::StepperMotorChoice> preset = sim::resolve_stepper_motor("nema23");
+  ASSERT_TRUE(preset && *preset);
+  EXPECT_EQ((*preset)->name, "nema23");
+  EXPECT_FALSE(*sim::resolve_stepper_motor("ideal"));
+  EXPECT_TRUE(sim::resolve_stepper_motor("ideal").error().empty());
 }
 
 // hfuzz finding: any positive number was taken, and a light or stiff rotor made the plant's
 // explicit integration diverge (rotor at 1e19 revolutions, NaN). Every key has a physical range,
 // and a motor whose rotor integration would be unstable is refused, naming the key and its bound.
 TEST(Tmcm142Module, stepper_description_keys_are_bounded_and_unstable_motors_refused) {
-  auto error_of = [](const char* json) { return sim::parse_stepper_motor_description(json, "m.json").error; };
+  auto error_of = [](const char* json) { return sim::parse_stepper_motor_description(json, "m.json").error(); };
   EXPECT_EQ(error_of(R"({"rotor_inertia_kg_m2": 1e-300})"), "m.json: \"rotor_inertia_kg_m2\" must be a number from 1e-08 to 1");
   EXPECT_EQ(error_of(R"({"rotor_inertia_kg_m2": 1e-9})"), "m.json: \"rotor_inertia_kg_m2\" must be a number from 1e-08 to 1");
   EXPECT_EQ(error_of(R"({"torque_constant_nm_per_a": 1000})"),
@@ -120,14 +120,14 @@ TEST(Tmcm142Module, stepper_description_keys_are_bounded_and_unstable_motors_ref
     file << R"({"base": "nema23", "rotor_inertia_kg_m2": 1e-7})";
   }
   Made made = make(path);
-  EXPECT_FALSE(made.result.module);
-  EXPECT_NE(made.result.error.find("\"rotor_inertia_kg_m2\" must be at least"), std::string::npos) << made.result.error;
+  EXPECT_FALSE(made.result);
+  EXPECT_NE(made.result.error().find("\"rotor_inertia_kg_m2\" must be at least"), std::string::npos) << made.result.error();
   std::remove(path.c_str());
 }
 
 TEST(Tmcm142Module, io_signals_reach_gio_and_sio_reaches_the_output_log) {
   Made made = make("ideal", {{"IN7", 1}, {"AIN2", 2047}, {"AIN1", 2048}, {"IN0", 1}});
-  VirtualModule& m = *made.result.module;
+  VirtualModule& m = **made.result;
   std::vector<int32_t> digital;
   for (uint8_t port = 0; port < 9; ++port) digital.push_back(execute(m, kGio, port, 0, 0).value);
   EXPECT_EQ(digital, (std::vector<int32_t>{1, 1, 0, 0, 0, 0, 0, 1, 0})) << "IN1 from AIN1 at half scale";
@@ -177,7 +177,7 @@ TEST(Tmcm142Module, switch_windows_follow_the_rotor_and_a_level_by_name_takes_ov
 // AP 15 past the switch and leaves the axis at rest in velocity mode, target unchanged.
 TEST(Tmcm142Module, a_limit_switch_hard_stop_makes_the_stop_point_the_target) {
   Made made = make();
-  VirtualModule& m = *made.result.module;
+  VirtualModule& m = **made.result;
   m.signals().set_input("REF_R_AT", 0.5);
   ASSERT_EQ(execute(m, kMvp, 0, kRev).status, tmcl::Status::kOk);
   run_ms(m, 2000);
@@ -199,7 +199,7 @@ TEST(Tmcm142Module, a_limit_switch_hard_stop_makes_the_stop_point_the_target) {
 
 TEST(Tmcm142Module, a_limit_switch_soft_stop_decelerates_past_the_switch) {
   Made made = make();
-  VirtualModule& m = *made.result.module;
+  VirtualModule& m = **made.result;
   m.signals().set_input("REF_R_AT", 0.5);
   sap(m, 14, 32);     // soft stop
   sap(m, 15, 140730);  // 2.05e6 µsteps/s², ten times AP 5: the switch is reached at about 1 rev/s
@@ -217,11 +217,11 @@ TEST(Tmcm142Module, a_limit_switch_soft_stop_decelerates_past_the_switch) {
 
 TEST(Tmcm142Module, reference_search_mode_2_measures_the_switch_distance_placed_by_signals) {
   Made made = make();
-  VirtualModule& m = *made.result.module;
-  const sim::ScenarioParseResult scenario =
+  VirtualModule& m = **made.result;
+  const Result<std::vector<sim::ScenarioEvent>> scenario =
       sim::parse_scenario("0 REF_R_AT 1.0\n0 REF_L_AT -0.5\n", "rfs.scn", m.signals().input_signals());
-  ASSERT_TRUE(scenario.ok()) << scenario.error;
-  sim::ScenarioPlayer player(scenario.events, m.signals());
+  ASSERT_TRUE(scenario.ok()) << scenario.error();
+  sim::ScenarioPlayer player(*scenario, m.signals());
   player.apply_due(0);
   sap(m, 193, 2);
   int32_t status = 0;
@@ -241,7 +241,7 @@ TEST(Tmcm142Module, reference_search_mode_2_measures_the_switch_distance_placed_
 // becomes 0; AP 196 measures from the cam's right edge to the right limit switch.
 TEST(Tmcm142Module, reference_search_mode_3_homes_on_the_centre_of_a_cam_window) {
   Made made = make("ideal", {{"REF_R_AT", 1.0}, {"REF_L_FROM", -0.5}, {"REF_L_TO", -0.4}});
-  VirtualModule& m = *made.result.module;
+  VirtualModule& m = **made.result;
   sap(m, 193, 3);
   ASSERT_EQ(execute(m, kRfs, 0, 0).status, tmcl::Status::kOk);
   int32_t status = 1;
@@ -261,12 +261,12 @@ TEST(Tmcm142Module, reference_search_mode_3_homes_on_the_centre_of_a_cam_window)
 TEST(Tmcm142Module, scenario_runs_on_the_physical_motor_are_bit_identical) {
   auto run = [](uint64_t batch) {
     Made made = make("nema23");
-    VirtualModule& m = *made.result.module;
+    VirtualModule& m = **made.result;
     HostRuntime runtime(m, Pacing::fast());
-    const sim::ScenarioParseResult scenario = sim::parse_scenario(
+    const Result<std::vector<sim::ScenarioEvent>> scenario = sim::parse_scenario(
         "0.2 LOAD_TORQUE 0.5\n0.4 VSUPPLY 12\n0.6 BLOCKED 1\n0.7 BLOCKED 0\n", "load.scn", m.signals().input_signals());
-    EXPECT_TRUE(scenario.ok()) << scenario.error;
-    runtime.set_scenario(scenario.events);
+    EXPECT_TRUE(scenario.ok()) << scenario.error();
+    runtime.set_scenario(*scenario);
     runtime.start();
     EXPECT_EQ(execute(m, kMvp, 0, 2 * kRev).status, tmcl::Status::kOk);
     std::vector<double> trace;
@@ -317,7 +317,7 @@ TEST(Tmcm142Module, the_index_pulse_is_where_the_signal_puts_it_and_setting_it_i
 
 TEST(Tmcm142Module, encoder_resolution_and_direction_come_from_the_signals) {
   Made made = make("ideal", {{"ENCODER_CPR", 1000}, {"ENCODER_REVERSED", 1}});
-  VirtualModule& m = *made.result.module;
+  VirtualModule& m = **made.result;
   sap(m, 42, 13421773);  // 204.8 µsteps per count: 1000 counts per revolution
   sap(m, 46, 1);         // and count the other way, as the encoder is reversed
   ASSERT_EQ(execute(m, kMvp, 0, kRev).status, tmcl::Status::kOk);
@@ -339,7 +339,7 @@ TEST(Tmcm142Module, encoder_resolution_and_direction_come_from_the_signals) {
 TEST(Tmcm142Module, an_overload_loses_steps_on_the_physical_motor_only) {
   for (const char* motor : {"ideal", "nema23"}) {
     Made made = make(motor, {{"LOAD_TORQUE", 2.0}});  // twice the NEMA23's holding torque
-    VirtualModule& m = *made.result.module;
+    VirtualModule& m = **made.result;
     ASSERT_EQ(execute(m, kMvp, 0, kRev).status, tmcl::Status::kOk);
     run_until_reached(m, 3000);
     EXPECT_EQ(gap(m, 1), kRev) << motor << ": the ramp arrives either way";

@@ -99,11 +99,11 @@ TEST(Tmcm1636StartupImage, a_value_the_table_refuses_is_not_written) {
 }
 
 TEST(Tmcm1636StartupImage, check_names_the_table_rule_that_fails) {
-  EXPECT_EQ(check_tmcm1636_axis_parameter(11, 60000), "");
-  EXPECT_EQ(check_tmcm1636_axis_parameter(11, 60001), "axis parameter 11 takes 0 to 60000, got 60001");
-  EXPECT_EQ(check_tmcm1636_axis_parameter(42, 1), "axis parameter 42 is not stored in the EEPROM");
-  EXPECT_EQ(check_tmcm1636_axis_parameter(300, 1), "axis parameter 300 does not exist");
-  EXPECT_EQ(check_tmcm1636_axis_parameter(-1, 1), "axis parameter -1 does not exist");
+  EXPECT_TRUE(check_tmcm1636_axis_parameter(11, 60000).ok());
+  EXPECT_EQ(check_tmcm1636_axis_parameter(11, 60001).error(), "axis parameter 11 takes 0 to 60000, got 60001");
+  EXPECT_EQ(check_tmcm1636_axis_parameter(42, 1).error(), "axis parameter 42 is not stored in the EEPROM");
+  EXPECT_EQ(check_tmcm1636_axis_parameter(300, 1).error(), "axis parameter 300 does not exist");
+  EXPECT_EQ(check_tmcm1636_axis_parameter(-1, 1).error(), "axis parameter -1 does not exist");
 }
 
 TEST(Tmcm1636StartupImage, a_file_with_named_settings_loads_and_writes_like_the_preset) {
@@ -111,25 +111,25 @@ TEST(Tmcm1636StartupImage, a_file_with_named_settings_loads_and_writes_like_the_
   const std::string path = (scratch.path() / "large.json").string();
   const sim::MotorDescription preset = *sim::motor_preset("large-48v");
   std::ofstream(path) << sim::motor_description_json(preset);
-  const sim::MotorLoadResult loaded = resolve_tmcm1636_motor(path);
-  ASSERT_TRUE(loaded.motor) << loaded.error;
-  EXPECT_EQ(image_of(*loaded.motor), image_of(preset));
-  EXPECT_EQ(axis_parameter(image_of(*loaded.motor), 141), 520);
+  const Result<sim::MotorChoice> loaded = resolve_tmcm1636_motor(path);
+  ASSERT_TRUE(loaded && *loaded) << loaded.error();
+  EXPECT_EQ(image_of(**loaded), image_of(preset));
+  EXPECT_EQ(axis_parameter(image_of(**loaded), 141), 520);
 }
 
 TEST(Tmcm1636StartupImage, a_file_the_module_cannot_start_with_names_file_and_setting) {
   testing::ScratchDirectory scratch;
   const std::string named = (scratch.path() / "named.json").string();
   std::ofstream(named) << R"({"flux_linkage_wb": 0.005, "startup": {"max_current_ma": 70000}})";
-  EXPECT_EQ(resolve_tmcm1636_motor(named).error,
+  EXPECT_EQ(resolve_tmcm1636_motor(named).error(),
             named + ": startup: max_current_ma: axis parameter 11 takes 0 to 60000, got 70000");
-  EXPECT_FALSE(resolve_tmcm1636_motor(named).motor);
+  EXPECT_FALSE(resolve_tmcm1636_motor(named).ok());
   const std::string numbered = (scratch.path() / "numbered.json").string();
   std::ofstream(numbered) << R"({"flux_linkage_wb": 0.005, "axis_parameters": {"42": 1}})";
-  EXPECT_EQ(resolve_tmcm1636_motor(numbered).error,
+  EXPECT_EQ(resolve_tmcm1636_motor(numbered).error(),
             numbered + ": axis_parameters: axis parameter 42 is not stored in the EEPROM");
-  EXPECT_TRUE(resolve_tmcm1636_motor("ideal").error.empty());
-  EXPECT_TRUE(resolve_tmcm1636_motor("dc-24v").motor);
+  EXPECT_TRUE(resolve_tmcm1636_motor("ideal").error().empty());
+  EXPECT_TRUE(*resolve_tmcm1636_motor("dc-24v"));
 }
 
 }  // namespace

@@ -86,23 +86,27 @@ TEST(Tmcm1636SimIo, a_flood_of_output_changes_keeps_only_the_newest) {
 
 TEST(SignalAssignment, parses_and_checks_name_and_value) {
   const auto signals = Tmcm1636SimIo::signal_table();
-  std::string error;
-  const auto supply = parse_signal_assignment(signals, "VSUPPLY=26.5", error);
-  ASSERT_TRUE(supply) << error;
+  const Result<SignalAssignment> supply = parse_signal_assignment(signals, "VSUPPLY=26.5");
+  ASSERT_TRUE(supply) << supply.error();
   EXPECT_EQ(supply->signal->name, "VSUPPLY");
   EXPECT_EQ(supply->value, 26.5);
 
-  EXPECT_FALSE(parse_signal_assignment(signals, "GPI0", error));
-  EXPECT_EQ(error, "expected SIGNAL=VALUE, got \"GPI0\"");
-  EXPECT_FALSE(parse_signal_assignment(signals, "GPI9=1", error));
-  EXPECT_NE(error.find("unknown signal \"GPI9\""), std::string::npos) << error;
-  EXPECT_FALSE(parse_signal_assignment(signals, "GPI0=2", error));
-  EXPECT_EQ(error, "GPI0 takes 0 or 1 (digital input level), got 2");
-  EXPECT_FALSE(parse_signal_assignment(signals, "AI0=1.5", error));
-  EXPECT_EQ(error, "AI0 takes a whole number from 0 to 4095 (raw 12-bit ADC count), got 1.5");
-  EXPECT_FALSE(parse_signal_assignment(signals, "TEMP=hot", error));
-  EXPECT_EQ(error, "value of TEMP is not a number: \"hot\"");
-  EXPECT_FALSE(parse_signal_assignment(signals, "TEMP=nan", error));
+  Result<SignalAssignment> refused = parse_signal_assignment(signals, "GPI0");
+  EXPECT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "expected SIGNAL=VALUE, got \"GPI0\"");
+  refused = parse_signal_assignment(signals, "GPI9=1");
+  EXPECT_FALSE(refused);
+  EXPECT_NE(refused.error().find("unknown signal \"GPI9\""), std::string::npos) << refused.error();
+  refused = parse_signal_assignment(signals, "GPI0=2");
+  EXPECT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "GPI0 takes 0 or 1 (digital input level), got 2");
+  refused = parse_signal_assignment(signals, "AI0=1.5");
+  EXPECT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "AI0 takes a whole number from 0 to 4095 (raw 12-bit ADC count), got 1.5");
+  refused = parse_signal_assignment(signals, "TEMP=hot");
+  EXPECT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "value of TEMP is not a number: \"hot\"");
+  EXPECT_FALSE(parse_signal_assignment(signals, "TEMP=nan"));
 }
 
 }  // namespace

@@ -162,74 +162,74 @@ TEST(MotorDescription, presets_have_their_documented_constants) {
 TEST(MotorDescription, json_round_trip_of_every_preset) {
   for (std::string_view name : motor_preset_names()) {
     const MotorDescription preset = *motor_preset(name);
-    const MotorLoadResult parsed = parse_motor_description(motor_description_json(preset), "x.json");
-    ASSERT_TRUE(parsed.motor) << parsed.error;
-    EXPECT_EQ(parsed.motor->name, preset.name);
-    EXPECT_DOUBLE_EQ(parsed.motor->torque_constant(), preset.torque_constant());
-    EXPECT_DOUBLE_EQ(parsed.motor->resistance_ohm, preset.resistance_ohm);
-    EXPECT_EQ(parsed.motor->abn.counts_per_rev, preset.abn.counts_per_rev);
-    EXPECT_EQ(parsed.motor->axis_parameters.size(), preset.axis_parameters.size());
-    EXPECT_EQ(parsed.motor->startup, preset.startup);
+    const Result<MotorDescription> parsed = parse_motor_description(motor_description_json(preset), "x.json");
+    ASSERT_TRUE(parsed) << parsed.error();
+    EXPECT_EQ(parsed->name, preset.name);
+    EXPECT_DOUBLE_EQ(parsed->torque_constant(), preset.torque_constant());
+    EXPECT_DOUBLE_EQ(parsed->resistance_ohm, preset.resistance_ohm);
+    EXPECT_EQ(parsed->abn.counts_per_rev, preset.abn.counts_per_rev);
+    EXPECT_EQ(parsed->axis_parameters.size(), preset.axis_parameters.size());
+    EXPECT_EQ(parsed->startup, preset.startup);
   }
 }
 
 TEST(MotorDescription, a_user_file_with_kv_and_comments) {
-  const MotorLoadResult parsed = parse_motor_description(R"({
+  const Result<MotorDescription> parsed = parse_motor_description(R"({
     // a hobby outrunner
     "name": "my-motor", "type": "bldc", "pole_pairs": 7, "kv_rpm_per_v": 270,
     "resistance_ohm": 0.05, "inductance_h": 2e-5, "rotor_inertia_kgm2": 1e-4,
     "abn_encoder": {"counts_per_rev": 8192},
     "axis_parameters": {"10": 7, "100": 8192}
   })", "my.json");
-  ASSERT_TRUE(parsed.motor) << parsed.error;
-  EXPECT_NEAR(parsed.motor->torque_constant(), 8.27 / 270.0, 1e-12);
-  EXPECT_DOUBLE_EQ(parsed.motor->inductance_d_h, 2e-5);
-  EXPECT_EQ(parsed.motor->axis_parameters.size(), 2u);
+  ASSERT_TRUE(parsed) << parsed.error();
+  EXPECT_NEAR(parsed->torque_constant(), 8.27 / 270.0, 1e-12);
+  EXPECT_DOUBLE_EQ(parsed->inductance_d_h, 2e-5);
+  EXPECT_EQ(parsed->axis_parameters.size(), 2u);
 }
 
 // Found by fuzz/motor_description.cpp: JSON keys come sorted as text ("100" before "14"), and
 // "05" is parameter 5 too. Start-up parameters apply in number order; a number given twice is an error.
 TEST(MotorDescription, axis_parameters_in_number_order_and_each_number_once) {
-  const MotorLoadResult parsed = parse_motor_description(
+  const Result<MotorDescription> parsed = parse_motor_description(
       R"({"flux_linkage_wb": 0.005, "axis_parameters": {"100": 8192, "25": 1, "14": 3, "05": 7}})", "p.json");
-  ASSERT_TRUE(parsed.motor) << parsed.error;
+  ASSERT_TRUE(parsed) << parsed.error();
   const std::vector<std::pair<uint8_t, int32_t>> expected{{5, 7}, {14, 3}, {25, 1}, {100, 8192}};
-  EXPECT_EQ(parsed.motor->axis_parameters, expected);
-  const MotorLoadResult again = parse_motor_description(motor_description_json(*parsed.motor), "q.json");
-  ASSERT_TRUE(again.motor) << again.error;
-  EXPECT_EQ(again.motor->axis_parameters, expected);
+  EXPECT_EQ(parsed->axis_parameters, expected);
+  const Result<MotorDescription> again = parse_motor_description(motor_description_json(*parsed), "q.json");
+  ASSERT_TRUE(again) << again.error();
+  EXPECT_EQ(again->axis_parameters, expected);
   EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"5": 1, "05": 2}})", "r.json")
-                .error,
+                .error(),
             "r.json: axis_parameters: parameter 5 is given twice");
 }
 
 TEST(MotorDescription, errors_name_the_file_and_the_problem) {
-  EXPECT_EQ(parse_motor_description("{", "a.json").error, "a.json: not valid JSON");
-  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 4, "flux_linkage_wb": 0.005, "resistanse_ohm": 1})", "b.json").error,
+  EXPECT_EQ(parse_motor_description("{", "a.json").error(), "a.json: not valid JSON");
+  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 4, "flux_linkage_wb": 0.005, "resistanse_ohm": 1})", "b.json").error(),
             "b.json: unknown key resistanse_ohm");
-  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 0, "flux_linkage_wb": 0.005})", "c.json").error,
+  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 0, "flux_linkage_wb": 0.005})", "c.json").error(),
             "c.json: pole_pairs must be from 1 to 255, got 0");
   EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"42": 1}})", "d.json",
                                     host::check_tmcm1636_axis_parameter)
-                .error,
+                .error(),
             "d.json: axis_parameters: axis parameter 42 is not stored in the EEPROM");
-  EXPECT_EQ(parse_motor_description(R"({"type": "dc"})", "e.json").error, "e.json: a DC motor needs torque_constant_nm_per_a");
-  EXPECT_EQ(resolve_motor("fast-one").error,
+  EXPECT_EQ(parse_motor_description(R"({"type": "dc"})", "e.json").error(), "e.json: a DC motor needs torque_constant_nm_per_a");
+  EXPECT_EQ(resolve_motor("fast-one").error(),
             "unknown motor \"fast-one\" (expected ideal, default-24v, large-48v, dc-24v or a .json file)");
-  EXPECT_FALSE(resolve_motor("ideal").motor);
-  EXPECT_TRUE(resolve_motor("ideal").error.empty());
+  EXPECT_FALSE(*resolve_motor("ideal"));
+  EXPECT_TRUE(resolve_motor("ideal").error().empty());
 }
 
 // Start-up settings are named values in the motor's units; numbered firmware parameters are
 // kept as given unless the caller checks them for its firmware (the host does).
 TEST(MotorDescription, startup_settings_are_named_values_of_the_file) {
-  const MotorLoadResult parsed = parse_motor_description(
+  const Result<MotorDescription> parsed = parse_motor_description(
       R"({"flux_linkage_wb": 0.005, "startup": {"max_current_ma": 1500, "commutation": "abn_encoder",
           "hall_interpolation": false, "brake_chopper_voltage_v": 30.5}, "axis_parameters": {"42": 1}})",
       "s.json");
-  ASSERT_TRUE(parsed.motor) << parsed.error;
-  ASSERT_TRUE(parsed.motor->startup);
-  const StartupSettings& startup = *parsed.motor->startup;
+  ASSERT_TRUE(parsed) << parsed.error();
+  ASSERT_TRUE(parsed->startup);
+  const StartupSettings& startup = *parsed->startup;
   EXPECT_EQ(startup.max_current_ma, 1500);
   EXPECT_EQ(startup.commutation, CommutationSensor::kAbnEncoder);
   EXPECT_EQ(startup.hall_interpolation, false);
@@ -237,21 +237,21 @@ TEST(MotorDescription, startup_settings_are_named_values_of_the_file) {
   EXPECT_FALSE(startup.open_loop_current_ma);
   EXPECT_FALSE(startup.encoder_alignment);
   const std::vector<std::pair<uint8_t, int32_t>> kept{{42, 1}};
-  EXPECT_EQ(parsed.motor->axis_parameters, kept) << "no firmware check: the motor keeps the number";
-  const MotorLoadResult again = parse_motor_description(motor_description_json(*parsed.motor), "t.json");
-  ASSERT_TRUE(again.motor) << again.error;
-  EXPECT_EQ(again.motor->startup, parsed.motor->startup);
+  EXPECT_EQ(parsed->axis_parameters, kept) << "no firmware check: the motor keeps the number";
+  const Result<MotorDescription> again = parse_motor_description(motor_description_json(*parsed), "t.json");
+  ASSERT_TRUE(again) << again.error();
+  EXPECT_EQ(again->startup, parsed->startup);
 
-  EXPECT_FALSE(parse_motor_description(R"({"flux_linkage_wb": 0.005})", "n.json").motor->startup);
-  EXPECT_TRUE(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {}})", "n.json").motor->startup);
-  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"commutation": "hal"}})", "e.json").error,
+  EXPECT_FALSE(parse_motor_description(R"({"flux_linkage_wb": 0.005})", "n.json")->startup);
+  EXPECT_TRUE(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {}})", "n.json")->startup);
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"commutation": "hal"}})", "e.json").error(),
             "e.json: startup.commutation must be one of \"open_loop\", \"hall\", \"abn_encoder\", "
             "\"absolute_encoder\", got \"hal\"");
-  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"max_current": 1}})", "f.json").error,
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"max_current": 1}})", "f.json").error(),
             "f.json: unknown key startup.max_current");
-  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"current_p": -1}})", "g.json").error,
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "startup": {"current_p": -1}})", "g.json").error(),
             "g.json: startup.current_p must be from 0 to 2.14748e+09, got -1");
-  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"256": 1}})", "h.json").error,
+  EXPECT_EQ(parse_motor_description(R"({"flux_linkage_wb": 0.005, "axis_parameters": {"256": 1}})", "h.json").error(),
             "h.json: axis_parameters: axis parameter 256 does not exist");
 }
 

@@ -279,11 +279,11 @@ TEST(Tmcm3216SimBoard, SignalTableAndScenarioFiles) {
   EXPECT_NE(find_signal(table, "AXIS0_REF_L"), nullptr);
   EXPECT_NE(find_signal(table, "VSUPPLY"), nullptr);
   EXPECT_EQ(find_signal(table, "AXIS3_REF_L"), nullptr);
-  const ScenarioParseResult parsed =
+  const Result<std::vector<ScenarioEvent>> parsed =
       parse_scenario("0.001 AXIS1_REF_L 1\n0.002 axis0_load_torque 0.1\n0.003 VSUPPLY 12\n", "test", table);
-  ASSERT_TRUE(parsed.ok()) << parsed.error;
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
   Rig rig;
-  ScenarioPlayer player(parsed.events, rig.board);
+  ScenarioPlayer player(*parsed, rig.board);
   EXPECT_EQ(player.apply_due(2000), 2u);
   EXPECT_EQ(*rig.board.read_signal("AXIS1_REF_L"), 0.0);  // seen at the next sample
   rig.tick();
@@ -291,7 +291,7 @@ TEST(Tmcm3216SimBoard, SignalTableAndScenarioFiles) {
   EXPECT_EQ(*rig.board.read_signal("AXIS0_LOAD_TORQUE"), 0.1);
   EXPECT_EQ(player.apply_due(3000), 1u);
   EXPECT_EQ(*rig.board.read_signal("VSUPPLY"), 12.0);
-  const ScenarioParseResult bad = parse_scenario("0 AXIS0_BRAKE 2\n", "test", table);
+  const Result<std::vector<ScenarioEvent>> bad = parse_scenario("0 AXIS0_BRAKE 2\n", "test", table);
   EXPECT_FALSE(bad.ok());
 }
 
@@ -301,8 +301,8 @@ TEST(Tmcm3216VirtualModule, BoardSignalsMotorChoiceAndTick) {
   options.initial_inputs = {{"AXIS1_REF_L", 1}, {"VSUPPLY", 36}};
   options.log = [](const std::string&) {};
   host::MakeModuleResult made = host::Tmcm3216VirtualModule::make(options);
-  ASSERT_TRUE(made.module) << made.error;
-  host::VirtualModule& module = *made.module;
+  ASSERT_TRUE(made) << made.error();
+  host::VirtualModule& module = **made;
   EXPECT_EQ(module.tick_period_us(), modules::tmcm3216::kTickUs);
   module.run_ticks(20);
   EXPECT_EQ(module.sim_time_us(), 20u * modules::tmcm3216::kTickUs);
@@ -315,7 +315,7 @@ TEST(Tmcm3216VirtualModule, BoardSignalsMotorChoiceAndTick) {
   EXPECT_EQ(typed.board().board().io.supply_millivolt, 36000);
 
   options.motor = "no-such-motor";
-  EXPECT_FALSE(host::Tmcm3216VirtualModule::make(options).module);
+  EXPECT_FALSE(host::Tmcm3216VirtualModule::make(options).ok());
 }
 
 }  // namespace

@@ -128,19 +128,19 @@ TEST(Tmcm3216SimInputs, OpeningTheShutdownSwitchFaultsEveryAxisWithOneEmcy5441) 
 }
 
 TEST(Tmcm3216SimInputs, ShutdownSwitchFromAScenarioAndAsInitialInput) {
-  const ScenarioParseResult parsed = parse_scenario("0.010 ENABLE 0\n0.030 ENABLE 1\n", "test", Tmcm3216SimBoard::signal_table());
-  ASSERT_TRUE(parsed.ok()) << parsed.error;
+  const Result<std::vector<ScenarioEvent>> parsed = parse_scenario("0.010 ENABLE 0\n0.030 ENABLE 1\n", "test", Tmcm3216SimBoard::signal_table());
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
   EXPECT_FALSE(parse_scenario("0 ENABLE 2\n", "test", Tmcm3216SimBoard::signal_table()).ok());
 
   host::ModuleOptions options;
   options.initial_inputs = {{"ENABLE", 0}};
   options.log = [](const std::string&) {};
   host::MakeModuleResult made = host::Tmcm3216VirtualModule::make(options);
-  ASSERT_TRUE(made.module) << made.error;
-  made.module->run_ticks(40);
-  auto& typed = static_cast<host::Tmcm3216VirtualModule&>(*made.module);
+  ASSERT_TRUE(made) << made.error();
+  (*made)->run_ticks(40);
+  auto& typed = static_cast<host::Tmcm3216VirtualModule&>(**made);
   EXPECT_FALSE(typed.board().board().io.enable_input);
-  EXPECT_EQ(*made.module->signals().read_signal("ENABLE"), 0.0);
+  EXPECT_EQ(*(*made)->signals().read_signal("ENABLE"), 0.0);
 }
 
 // --- 2001: full steps per revolution -------------------------------------------------------------
@@ -228,51 +228,52 @@ TEST(Tmcm3216SimInputs, FullStepResolutionThatMismatchesTheMotorOnlyScales) {
 // --- --motor per axis ----------------------------------------------------------------------------
 
 TEST(StepperMotorSelection, OneMotorForAllAxesOrOnePerAxis) {
-  StepperMotorChoices all = resolve_stepper_motors("nema23", 3);
-  ASSERT_TRUE(all.error.empty()) << all.error;
-  ASSERT_EQ(all.motors.size(), 3u);
-  for (const auto& motor : all.motors) {
+  Result<std::vector<StepperMotorChoice>> all = resolve_stepper_motors("nema23", 3);
+  ASSERT_TRUE(all.error().empty()) << all.error();
+  ASSERT_EQ(all->size(), 3u);
+  for (const auto& motor : *all) {
     ASSERT_TRUE(motor);
     EXPECT_EQ(motor->name, "nema23");
   }
-  StepperMotorChoices ideal = resolve_stepper_motors("", 3);
-  ASSERT_TRUE(ideal.error.empty());
-  ASSERT_EQ(ideal.motors.size(), 3u);
-  EXPECT_FALSE(ideal.motors[0] || ideal.motors[1] || ideal.motors[2]);
+  Result<std::vector<StepperMotorChoice>> ideal = resolve_stepper_motors("", 3);
+  ASSERT_TRUE(ideal.error().empty());
+  ASSERT_EQ(ideal->size(), 3u);
+  EXPECT_FALSE((*ideal)[0] || (*ideal)[1] || (*ideal)[2]);
 
-  StepperMotorChoices mixed = resolve_stepper_motors(" nema17, ideal ,nema23", 3);
-  ASSERT_TRUE(mixed.error.empty()) << mixed.error;
-  ASSERT_EQ(mixed.motors.size(), 3u);
-  ASSERT_TRUE(mixed.motors[0]);
-  EXPECT_EQ(mixed.motors[0]->name, "nema17");
-  EXPECT_FALSE(mixed.motors[1]);
-  ASSERT_TRUE(mixed.motors[2]);
-  EXPECT_EQ(mixed.motors[2]->name, "nema23");
+  Result<std::vector<StepperMotorChoice>> mixed = resolve_stepper_motors(" nema17, ideal ,nema23", 3);
+  ASSERT_TRUE(mixed.error().empty()) << mixed.error();
+  ASSERT_EQ(mixed->size(), 3u);
+  ASSERT_TRUE((*mixed)[0]);
+  EXPECT_EQ((*mixed)[0]->name, "nema17");
+  EXPECT_FALSE((*mixed)[1]);
+  ASSERT_TRUE((*mixed)[2]);
+  EXPECT_EQ((*mixed)[2]->name, "nema23");
 
   // A description file as one item.
   const std::filesystem::path file = std::filesystem::temp_directory_path() / "motwin-sim3216-0.9deg.json";
   std::ofstream(file) << R"({"base": "nema17", "name": "fine", "full_steps_per_revolution": 400})";
-  StepperMotorChoices with_file = resolve_stepper_motors("ideal,ideal," + file.string(), 3);
-  ASSERT_TRUE(with_file.error.empty()) << with_file.error;
-  ASSERT_TRUE(with_file.motors[2]);
-  EXPECT_EQ(with_file.motors[2]->name, "fine");
-  EXPECT_EQ(with_file.motors[2]->full_steps_per_revolution, 400);
+  Result<std::vector<StepperMotorChoice>> with_file = resolve_stepper_motors("ideal,ideal," + file.string(), 3);
+  ASSERT_TRUE(with_file.error().empty()) << with_file.error();
+  ASSERT_TRUE((*with_file)[2]);
+  EXPECT_EQ((*with_file)[2]->name, "fine");
+  EXPECT_EQ((*with_file)[2]->full_steps_per_revolution, 400);
   std::filesystem::remove(file);
 }
 
 TEST(StepperMotorSelection, WrongCountEmptyOrUnknownItemIsAnErrorNamingIt) {
-  StepperMotorChoices two = resolve_stepper_motors("nema17,ideal", 3);
-  EXPECT_TRUE(two.motors.empty());
-  EXPECT_NE(two.error.find("names 2 motors for 3 axes"), std::string::npos) << two.error;
-  StepperMotorChoices four = resolve_stepper_motors("ideal,ideal,ideal,ideal", 3);
-  EXPECT_NE(four.error.find("names 4 motors for 3 axes"), std::string::npos) << four.error;
-  StepperMotorChoices unknown = resolve_stepper_motors("nema17,nema99,nema23", 3);
-  EXPECT_TRUE(unknown.motors.empty());
-  EXPECT_NE(unknown.error.find("motor of axis 1: unknown stepper motor \"nema99\""), std::string::npos) << unknown.error;
-  StepperMotorChoices empty = resolve_stepper_motors("nema17,,nema23", 3);
-  EXPECT_NE(empty.error.find("motor of axis 1: empty name"), std::string::npos) << empty.error;
-  StepperMotorChoices single = resolve_stepper_motors("nema99", 3);
-  EXPECT_NE(single.error.find("unknown stepper motor \"nema99\""), std::string::npos) << single.error;
+  // A failure resolves no motor at all: the Result holds no list.
+  Result<std::vector<StepperMotorChoice>> two = resolve_stepper_motors("nema17,ideal", 3);
+  EXPECT_FALSE(two.ok());
+  EXPECT_NE(two.error().find("names 2 motors for 3 axes"), std::string::npos) << two.error();
+  Result<std::vector<StepperMotorChoice>> four = resolve_stepper_motors("ideal,ideal,ideal,ideal", 3);
+  EXPECT_NE(four.error().find("names 4 motors for 3 axes"), std::string::npos) << four.error();
+  Result<std::vector<StepperMotorChoice>> unknown = resolve_stepper_motors("nema17,nema99,nema23", 3);
+  EXPECT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.error().find("motor of axis 1: unknown stepper motor \"nema99\""), std::string::npos) << unknown.error();
+  Result<std::vector<StepperMotorChoice>> empty = resolve_stepper_motors("nema17,,nema23", 3);
+  EXPECT_NE(empty.error().find("motor of axis 1: empty name"), std::string::npos) << empty.error();
+  Result<std::vector<StepperMotorChoice>> single = resolve_stepper_motors("nema99", 3);
+  EXPECT_NE(single.error().find("unknown stepper motor \"nema99\""), std::string::npos) << single.error();
 }
 
 TEST(Tmcm3216SimInputs, BadMotorListTouchesNoFile) {
@@ -284,8 +285,8 @@ TEST(Tmcm3216SimInputs, BadMotorListTouchesNoFile) {
   options.state_dir = dir;
   options.log = [](const std::string&) {};
   const host::MakeModuleResult made = host::Tmcm3216VirtualModule::make(options);
-  EXPECT_FALSE(made.module);
-  EXPECT_NE(made.error.find("names 2 motors for 3 axes"), std::string::npos) << made.error;
+  EXPECT_FALSE(made);
+  EXPECT_NE(made.error().find("names 2 motors for 3 axes"), std::string::npos) << made.error();
   EXPECT_TRUE(std::filesystem::is_empty(dir));
   std::filesystem::remove_all(dir);
 }
@@ -295,8 +296,8 @@ TEST(Tmcm3216SimInputs, AxesWithDifferentMotorsBehaveDifferently) {
   options.motor = "nema17,ideal,nema23";
   options.log = [](const std::string&) {};
   host::MakeModuleResult made = host::Tmcm3216VirtualModule::make(options);
-  ASSERT_TRUE(made.module) << made.error;
-  auto& module = static_cast<host::Tmcm3216VirtualModule&>(*made.module);
+  ASSERT_TRUE(made) << made.error();
+  auto& module = static_cast<host::Tmcm3216VirtualModule&>(**made);
   Tmcm3216SimBoard& board = module.board();
   EXPECT_NE(board.plant(0), nullptr);
   EXPECT_EQ(board.plant(1), nullptr);

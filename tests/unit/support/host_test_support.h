@@ -160,8 +160,8 @@ struct ModuleOnRuntime {
   explicit ModuleOnRuntime(host::Pacing pacing = host::Pacing::realtime(), host::ModuleOptions options = {}) {
     options.log = [](const std::string&) {};
     host::MakeModuleResult made = host::make_module("tmcm-1636", options);
-    EXPECT_TRUE(made.module) << made.error;
-    module = std::move(made.module);
+    EXPECT_TRUE(made) << made.error();
+    module = std::move(*made);
     runtime = std::make_unique<host::HostRuntime>(*module, pacing);
     runtime->start();
   }

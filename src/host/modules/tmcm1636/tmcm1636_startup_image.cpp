@@ -107,37 +107,36 @@ std::vector<Tmcm1636StartupParameter> tmcm1636_startup_parameters(const MotorDes
   return parameters;
 }
 
-std::string check_tmcm1636_axis_parameter(int number, int64_t value) {
+Result<void> check_tmcm1636_axis_parameter(int number, int64_t value) {
   const auto* row = number >= 0 && number <= 255 ? Tmcm1636::axis_parameters().find(static_cast<uint16_t>(number)) : nullptr;
-  if (row == nullptr) return "axis parameter " + std::to_string(number) + " does not exist";
+  if (row == nullptr) return Error{"axis parameter " + std::to_string(number) + " does not exist"};
   if (!params::has(row->info.access, params::Access::kEeprom)) {
-    return "axis parameter " + std::to_string(number) + " is not stored in the EEPROM";
+    return Error{"axis parameter " + std::to_string(number) + " is not stored in the EEPROM"};
   }
   if (value < row->info.min || value > row->info.max) {
-    return "axis parameter " + std::to_string(number) + " takes " + std::to_string(row->info.min) + " to " +
-           std::to_string(row->info.max) + ", got " + std::to_string(value);
+    return Error{"axis parameter " + std::to_string(number) + " takes " + std::to_string(row->info.min) + " to " +
+                 std::to_string(row->info.max) + ", got " + std::to_string(value)};
   }
   return {};
 }
 
-sim::MotorLoadResult resolve_tmcm1636_motor(std::string_view name_or_path) {
-  sim::MotorLoadResult result = sim::resolve_motor(name_or_path, check_tmcm1636_axis_parameter);
-  if (!result.motor) return result;
+Result<sim::MotorChoice> resolve_tmcm1636_motor(std::string_view name_or_path) {
+  Result<sim::MotorChoice> motor = sim::resolve_motor(name_or_path, check_tmcm1636_axis_parameter);
+  if (!motor || !*motor) return motor;
   // The numbered ones were checked while parsing; the named ones are checked here.
-  for (const Tmcm1636StartupParameter& parameter : named_parameters(*result.motor)) {
-    if (std::string problem = check_tmcm1636_axis_parameter(parameter.number, parameter.value); !problem.empty()) {
-      result.error = std::string(name_or_path) + ": startup: " + std::string(parameter.source) + ": " + problem;
-      result.motor.reset();
-      return result;
+  for (const Tmcm1636StartupParameter& parameter : named_parameters(**motor)) {
+    if (const Result<void> usable = check_tmcm1636_axis_parameter(parameter.number, parameter.value); !usable) {
+      return usable.error_with_context(std::string(name_or_path) + ": startup: " + std::string(parameter.source) +
+                                       ": ");
     }
   }
-  return result;
+  return motor;
 }
 
 void write_tmcm1636_startup_image(const MotorDescription& motor, uint8_t* image, size_t size) {
   if (size < Tmcm1636::kNvmLayout.total_size) return;
   for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(motor)) {
-    if (!check_tmcm1636_axis_parameter(parameter.number, parameter.value).empty()) continue;
+    if (!check_tmcm1636_axis_parameter(parameter.number, parameter.value)) continue;
     tmcl::put_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, parameter.number), parameter.value);
   }
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "sim/modules/tmcm1636/motor_description.h"
+#include "types/result.h"
 
 namespace motwin::host {
 
@@ -29,14 +30,14 @@ struct Tmcm1636StartupParameter {
 // the file gives by number (which win where both name one).
 std::vector<Tmcm1636StartupParameter> tmcm1636_startup_parameters(const sim::MotorDescription& motor);
 
-// Empty when the TMCM-1636 stores axis parameter `number` in its EEPROM (E) and takes `value`;
+// Success when the TMCM-1636 stores axis parameter `number` in its EEPROM (E) and takes `value`;
 // else what is wrong ("axis parameter 42 is not stored in the EEPROM"). The
 // sim::AxisParameterCheck of the module's description files.
-std::string check_tmcm1636_axis_parameter(int number, int64_t value);
+Result<void> check_tmcm1636_axis_parameter(int number, int64_t value);
 
 // sim::resolve_motor with every start-up value checked against the table: a description the
 // module cannot start with is an error naming the file (`<file>: startup: <key>: <problem>`).
-sim::MotorLoadResult resolve_tmcm1636_motor(std::string_view name_or_path);
+Result<sim::MotorChoice> resolve_tmcm1636_motor(std::string_view name_or_path);
 
 // Writes the motor's start-up values into a TMCM-1636 EEPROM image that holds the factory
 // defaults; a value the table refuses is skipped (resolve_tmcm1636_motor refuses such files).

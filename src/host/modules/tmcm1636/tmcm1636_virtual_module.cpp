@@ -7,23 +7,24 @@ namespace motwin::host {
 template <>
 MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
   // The motor is checked before any file is touched.
-  sim::MotorLoadResult motor = resolve_tmcm1636_motor(options.motor);
-  if (!motor.error.empty()) return refused(motor.error);
+  const Result<sim::MotorChoice> chosen = resolve_tmcm1636_motor(options.motor);
+  if (!chosen) return Error{chosen.error()};
+  const sim::MotorChoice& motor = *chosen;
   // A physical motor's start-up settings go into a fresh image (docs/tmcm-1636-servo.md).
   const auto format_image = [&motor](uint8_t* image, size_t size) {
     Device::format_factory_image(image, size);
-    if (motor.motor) write_tmcm1636_startup_image(*motor.motor, image, size);
+    if (motor) write_tmcm1636_startup_image(*motor, image, size);
   };
   const auto build_device = [&](Tmcm1636VirtualModule& module) {
     board::NonVolatileMemory& nvm = module.eeprom_.nvm();
-    if (motor.motor && module.eeprom_.file() && !tmcm1636_image_configures_motor(nvm.data(), nvm.size())) {
+    if (motor && module.eeprom_.file() && !tmcm1636_image_configures_motor(nvm.data(), nvm.size())) {
       options.log("motwin: the EEPROM image " + module.eeprom_.location() + " has motor type 0 (no motor); " +
-                  motor.motor->name + " start-up settings go into new images only (docs/tmcm-1636-servo.md)");
+                  motor->name + " start-up settings go into new images only (docs/tmcm-1636-servo.md)");
     }
     module.device_.emplace(nvm, module.io_);
     if (board::Tmcm1636PowerStage* stage = module.board_->power_stage()) module.device_->axis().attach_power_stage(stage);
   };
-  return power_up_on_board(options, motor.motor, format_image, build_device);
+  return power_up_on_board(options, motor, format_image, build_device);
 }
 
 }  // namespace motwin::host

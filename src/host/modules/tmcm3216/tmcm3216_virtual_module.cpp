@@ -10,24 +10,18 @@ namespace motwin::host {
 std::span<const sim::SignalInfo> Tmcm3216VirtualModule::signal_table() { return sim::Tmcm3216SimBoard::signal_table(); }
 
 MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
-  MakeModuleResult result;
-  if (options.node_id > 127) {
-    result.error = "node ID " + std::to_string(options.node_id) + " is out of range (1..127)";
-    return result;
-  }
+  if (options.node_id > 127) return Error{"node ID " + std::to_string(options.node_id) + " is out of range (1..127)"};
   // The motor is checked before any file is touched.
-  sim::StepperMotorChoices motor = sim::resolve_stepper_motors(options.motor, sim::Tmcm3216SimBoard::kAxisCount);
-  if (!motor.error.empty()) {
-    result.error = motor.error;
-    return result;
-  }
+  const Result<std::vector<sim::StepperMotorChoice>> motors =
+      sim::resolve_stepper_motors(options.motor, sim::Tmcm3216SimBoard::kAxisCount);
+  if (!motors) return Error{motors.error()};
   std::unique_ptr<Tmcm3216VirtualModule> module(new Tmcm3216VirtualModule());
   const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), &Device::format_factory_image);
-  if (!eeprom) return MakeModuleResult{nullptr, eeprom.error()};
+  if (!eeprom) return Error{eeprom.error()};
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
   config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
-  module->board_ = std::make_unique<sim::Tmcm3216SimBoard>(motor.motors);
+  module->board_ = std::make_unique<sim::Tmcm3216SimBoard>(*motors);
   for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
   module->board_->before_tick();
   board::CanController& controller = *module;  // private base: reachable here only
@@ -35,8 +29,7 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a
   // master joins later. Masters send an NMT reset to see one (docs/canopen.md).
   module->device_->power_up();
-  result.module = std::move(module);
-  return result;
+  return MakeModuleResult(std::move(module));
 }
 
 Tmcm3216VirtualModule::~Tmcm3216VirtualModule() { disconnect(); }

@@ -1,6 +1,8 @@
 #include "sim/modules/tmcm1636/motor_description.h"
 
 #include <algorithm>
+#include <cctype>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -427,35 +429,8 @@ OrderedJson startup_json(const StartupSettings& settings) {
   return j;
 }
 
-}  // namespace
-
-std::vector<std::string_view> motor_preset_names() { return {"default-24v", "large-48v", "dc-24v"}; }
-
-std::optional<MotorDescription> motor_preset(std::string_view name) {
-  if (name == "default-24v") return default_24v();
-  if (name == "large-48v") return large_48v();
-  if (name == "dc-24v") return dc_24v();
-  return std::nullopt;
-}
-
-MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name,
-                                        const AxisParameterCheck& check) {
-  MotorLoadResult result;
-  const std::string prefix = std::string(source_name) + ": ";
-  Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
-  if (document.is_discarded()) {
-    result.error = prefix + "not valid JSON";
-    return result;
-  }
-  if (!document.is_object()) {
-    result.error = prefix + "expected a JSON object";
-    return result;
-  }
-  MotorDescription m;
-  std::string error;
-  Reader top{document, "", error};
-  top.text("name", m.name);
-  top.text("source", m.source);
+// "type": "bldc" (the default) or "dc"; a DC motor has no hall sensors.
+void read_kind(Reader& top, MotorDescription& m) {
   std::string kind = "bldc";
   top.text("type", kind);
   if (kind == "dc") {
@@ -464,12 +439,11 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   } else if (kind != "bldc") {
     top.fail("type must be \"bldc\" or \"dc\", got \"" + kind + "\"");
   }
-  top.integer("pole_pairs", m.pole_pairs, 1, 255);
-  // Both inductances at once; inductance_d_h / inductance_q_h (kMotorFields) override it.
-  double inductance = -1.0;
-  top.number("inductance_h", inductance, 1e-7, 1.0);
-  if (inductance > 0.0) m.inductance_d_h = m.inductance_q_h = inductance;
-  // The magnet strength, in whichever form the datasheet gives it.
+}
+
+// The magnet strength, in whichever form the datasheet gives it: a DC motor's torque constant,
+// or a BLDC motor's flux linkage, torque constant or KV. After "type" and "pole_pairs".
+void read_magnet_strength(Reader& top, MotorDescription& m) {
   double flux = -1.0;
   double kt = -1.0;
   double kv = -1.0;
@@ -489,6 +463,86 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   } else {
     top.fail("give one of flux_linkage_wb, torque_constant_nm_per_a or kv_rpm_per_v");
   }
+}
+
+// An "axis_parameters" key: a decimal parameter number as strtol reads it (leading blanks and
+// a sign allowed, nothing after the digits); nullopt for anything else or a negative number.
+std::optional<int> parameter_number(std::string_view key) {
+  while (!key.empty() && std::isspace(static_cast<unsigned char>(key.front()))) key.remove_prefix(1);
+  if (key.starts_with('+')) key.remove_prefix(1);
+  int number = -1;
+  const auto [end, problem] = std::from_chars(key.data(), key.data() + key.size(), number);
+  if (key.empty() || problem != std::errc{} || end != key.data() + key.size() || number < 0) return std::nullopt;
+  return number;
+}
+
+// One "axis_parameters" entry: success when it can go into the image; `check` knows the firmware.
+Result<void> check_axis_parameter(int number, int64_t value, const AxisParameterCheck& check) {
+  if (check) {
+    if (Result<void> checked = check(number, value); !checked) return checked;
+  }
+  // TMCL parameter numbers are one byte and values 32 bits, whatever the firmware.
+  if (number > 255) return Error{"axis parameter " + std::to_string(number) + " does not exist"};
+  if (value < std::numeric_limits<int32_t>::min() || value > std::numeric_limits<int32_t>::max()) {
+    return Error{"axis parameter " + std::to_string(number) + " takes 32-bit values, got " + std::to_string(value)};
+  }
+  return {};
+}
+
+// "axis_parameters": {"number": value, ...}, kept in parameter-number order.
+void read_axis_parameters(Reader& top, const AxisParameterCheck& check, std::vector<std::pair<uint8_t, int32_t>>& out) {
+  const Json* parameters = top.find("axis_parameters");
+  if (parameters == nullptr || !top.ok()) return;
+  if (!parameters->is_object()) return top.fail("axis_parameters must be an object of \"number\": value");
+  for (const auto& [key, value] : parameters->items()) {
+    const std::optional<int> number = parameter_number(key);
+    if (!number) return top.fail("axis_parameters: \"" + key + "\" is not a parameter number");
+    if (!value.is_number_integer()) return top.fail("axis_parameters." + key + " must be a whole number");
+    const int64_t v = value.get<int64_t>();
+    if (const Result<void> usable = check_axis_parameter(*number, v, check); !usable) {
+      return top.fail("axis_parameters: " + usable.error());
+    }
+    const bool repeated =
+        std::any_of(out.begin(), out.end(), [&number](const auto& entry) { return entry.first == *number; });
+    if (repeated) {  // "5" and "05": which one wins would depend on the spelling
+      return top.fail("axis_parameters: parameter " + std::to_string(*number) + " is given twice");
+    }
+    out.emplace_back(static_cast<uint8_t>(*number), static_cast<int32_t>(v));
+  }
+  // JSON objects have no order (the parser hands keys over sorted as text: "100" before "14"):
+  // apply in parameter-number order, so that writing and reading a file keeps it.
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+}
+
+}  // namespace
+
+std::vector<std::string_view> motor_preset_names() { return {"default-24v", "large-48v", "dc-24v"}; }
+
+std::optional<MotorDescription> motor_preset(std::string_view name) {
+  if (name == "default-24v") return default_24v();
+  if (name == "large-48v") return large_48v();
+  if (name == "dc-24v") return dc_24v();
+  return std::nullopt;
+}
+
+Result<MotorDescription> parse_motor_description(std::string_view json_text, std::string_view source_name,
+                                                 const AxisParameterCheck& check) {
+  const std::string prefix = std::string(source_name) + ": ";
+  const Json document = Json::parse(json_text.begin(), json_text.end(), nullptr, false, true);
+  if (document.is_discarded()) return Error{prefix + "not valid JSON"};
+  if (!document.is_object()) return Error{prefix + "expected a JSON object"};
+  MotorDescription m;
+  std::string error;
+  Reader top{document, "", error};
+  top.text("name", m.name);
+  top.text("source", m.source);
+  read_kind(top, m);
+  top.integer("pole_pairs", m.pole_pairs, 1, 255);
+  // Both inductances at once; inductance_d_h / inductance_q_h (kMotorFields) override it.
+  double inductance = -1.0;
+  top.number("inductance_h", inductance, 1e-7, 1.0);
+  if (inductance > 0.0) m.inductance_d_h = m.inductance_q_h = inductance;
+  read_magnet_strength(top, m);
   read_fields<MotorDescription>(top, m, kMotorFields);
   read_section<Hall>(top, "hall", m.hall, kHallFields);
   read_section<Abn>(top, "abn_encoder", m.abn, kAbnFields);
@@ -496,88 +550,32 @@ MotorLoadResult parse_motor_description(std::string_view json_text, std::string_
   read_section<Brake>(top, "brake", m.brake, kBrakeFields);
   read_section<Supply>(top, "supply", m.supply, kSupplyFields);
   read_startup(top, m.startup);
-  if (const Json* parameters = top.find("axis_parameters"); parameters != nullptr && top.ok()) {
-    if (!parameters->is_object()) {
-      top.fail("axis_parameters must be an object of \"number\": value");
-    } else {
-      for (const auto& [key, value] : parameters->items()) {
-        int number = -1;
-        try {
-          size_t used = 0;
-          number = std::stoi(key, &used);
-          if (used != key.size()) number = -1;
-        } catch (const std::exception&) {
-          number = -1;
-        }
-        if (number < 0) {
-          top.fail("axis_parameters: \"" + key + "\" is not a parameter number");
-          break;
-        }
-        if (!value.is_number_integer()) {
-          top.fail("axis_parameters." + key + " must be a whole number");
-          break;
-        }
-        const int64_t v = value.get<int64_t>();
-        std::string problem = check ? check(number, v) : std::string();
-        // TMCL parameter numbers are one byte and values 32 bits, whatever the firmware.
-        if (problem.empty() && number > 255) problem = "axis parameter " + std::to_string(number) + " does not exist";
-        if (problem.empty() && (v < std::numeric_limits<int32_t>::min() || v > std::numeric_limits<int32_t>::max())) {
-          problem = "axis parameter " + std::to_string(number) + " takes 32-bit values, got " + std::to_string(v);
-        }
-        if (!problem.empty()) {
-          top.fail("axis_parameters: " + problem);
-          break;
-        }
-        const bool repeated = std::any_of(m.axis_parameters.begin(), m.axis_parameters.end(),
-                                          [number](const auto& entry) { return entry.first == number; });
-        if (repeated) {  // "5" and "05": which one wins would depend on the spelling
-          top.fail("axis_parameters: parameter " + std::to_string(number) + " is given twice");
-          break;
-        }
-        m.axis_parameters.emplace_back(static_cast<uint8_t>(number), static_cast<int32_t>(v));
-      }
-      // JSON objects have no order (the parser hands keys over sorted as text: "100" before
-      // "14"): apply in parameter-number order, so that writing and reading a file keeps it.
-      std::stable_sort(m.axis_parameters.begin(), m.axis_parameters.end(),
-                       [](const auto& a, const auto& b) { return a.first < b.first; });
-    }
-  }
+  read_axis_parameters(top, check, m.axis_parameters);
   if (top.ok()) top.finish();
-  if (!error.empty()) {
-    result.error = prefix + error;
-    return result;
-  }
+  if (!error.empty()) return Error{prefix + error};
   if (m.name.empty()) m.name = std::string(source_name);
-  result.motor = std::move(m);
-  return result;
+  return m;
 }
 
-MotorLoadResult load_motor_description_file(const std::string& path, const AxisParameterCheck& check) {
+Result<MotorDescription> load_motor_description_file(const std::string& path, const AxisParameterCheck& check) {
   std::ifstream file(path);
-  if (!file) {
-    MotorLoadResult result;
-    result.error = "cannot read motor description " + path;
-    return result;
-  }
+  if (!file) return Error{"cannot read motor description " + path};
   std::stringstream contents;
   contents << file.rdbuf();
   return parse_motor_description(contents.str(), path, check);
 }
 
-MotorLoadResult resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check) {
-  MotorLoadResult result;
-  if (name_or_path.empty() || name_or_path == "ideal") return result;
-  if (std::optional<MotorDescription> preset = motor_preset(name_or_path)) {
-    result.motor = std::move(preset);
-    return result;
-  }
+Result<MotorChoice> resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check) {
+  if (name_or_path.empty() || name_or_path == "ideal") return MotorChoice{};
+  if (std::optional<MotorDescription> preset = motor_preset(name_or_path)) return preset;
   if (name_or_path.find('/') == std::string_view::npos && name_or_path.find('.') == std::string_view::npos) {
     std::string names = "ideal";
     for (std::string_view preset_name : motor_preset_names()) names += ", " + std::string(preset_name);
-    result.error = "unknown motor \"" + std::string(name_or_path) + "\" (expected " + names + " or a .json file)";
-    return result;
+    return Error{"unknown motor \"" + std::string(name_or_path) + "\" (expected " + names + " or a .json file)"};
   }
-  return load_motor_description_file(std::string(name_or_path), check);
+  Result<MotorDescription> described = load_motor_description_file(std::string(name_or_path), check);
+  if (!described) return Error{described.error()};
+  return MotorChoice{std::move(*described)};
 }
 
 std::string motor_description_json(const MotorDescription& m) {

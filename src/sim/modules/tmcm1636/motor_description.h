@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include "types/result.h"
+
 namespace motwin::sim {
 
 enum class MotorKind : uint8_t { kBldc, kDc };
@@ -122,23 +124,21 @@ struct MotorDescription {
 std::vector<std::string_view> motor_preset_names();
 std::optional<MotorDescription> motor_preset(std::string_view name);
 
-struct MotorLoadResult {
-  std::optional<MotorDescription> motor;
-  std::string error;  // "<file>: <what is wrong>" when motor is empty
-};
+// The motor behind the power stage as `--motor` chose it; nullopt: the ideal motor.
+using MotorChoice = std::optional<MotorDescription>;
 
-// Checks one "axis_parameters" entry for the firmware that will get it: empty when it stores
+// Checks one "axis_parameters" entry for the firmware that will get it: success when it stores
 // parameter `number` and takes `value`, else what is wrong. Without a check, any number 0..255
 // and any 32-bit value is kept.
-using AxisParameterCheck = std::function<std::string(int number, int64_t value)>;
+using AxisParameterCheck = std::function<Result<void>(int number, int64_t value)>;
 
-// Parses a JSON motor description (docs/tmcm-1636-servo.md, "Motor description files").
-MotorLoadResult parse_motor_description(std::string_view json_text, std::string_view source_name,
-                                        const AxisParameterCheck& check = {});
-MotorLoadResult load_motor_description_file(const std::string& path, const AxisParameterCheck& check = {});
-// A preset name or a file path; "ideal" (or empty) is not a motor and gives an empty result
-// without error.
-MotorLoadResult resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check = {});
+// Parses a JSON motor description (docs/tmcm-1636-servo.md, "Motor description files"); an
+// error reads "<file>: <what is wrong>".
+Result<MotorDescription> parse_motor_description(std::string_view json_text, std::string_view source_name,
+                                                 const AxisParameterCheck& check = {});
+Result<MotorDescription> load_motor_description_file(const std::string& path, const AxisParameterCheck& check = {});
+// A preset name or a file path; "ideal" (or empty) is not a motor: nullopt, no error.
+Result<MotorChoice> resolve_motor(std::string_view name_or_path, const AxisParameterCheck& check = {});
 // The description as JSON (the file format), e.g. to start a file from a preset.
 std::string motor_description_json(const MotorDescription& motor);
 
