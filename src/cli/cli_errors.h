@@ -1,4 +1,6 @@
-// Exit statuses and error lines shared by the `motwin` subcommands.
+// Exit statuses and error lines shared by the `motwin` subcommands. A step of a command that can
+// fail returns Result (docs/architecture.md, "Errors outside the core"); the command turns the
+// failure into its `motwin: error:` line and its exit status.
 #pragma once
 
 #include <iostream>
@@ -12,5 +14,11 @@ inline constexpr int kExitUsageError = 2;   // bad arguments, no connection, no 
 
 // "motwin: error: MESSAGE" on stderr.
 inline void print_error(std::string_view message) { std::cerr << "motwin: error: " << message << '\n'; }
+
+// Ends a command on a usage error: prints its error line and gives kExitUsageError.
+inline int usage_error(std::string_view message) {
+  print_error(message);
+  return kExitUsageError;
+}
 
 }  // namespace motwin::cli

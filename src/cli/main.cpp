@@ -1,7 +1,9 @@
 #include <CLI/CLI.hpp>
 
+#include <exception>
 #include <string>
 
+#include "cli/cli_errors.h"
 #include "cli/commands.h"
 #include "host/module_registry.h"
 
@@ -40,10 +42,15 @@ int main(int argc, char** argv) {
   app.failure_message([](const CLI::App*, const CLI::Error& error) {
     return std::string("motwin: error: ") + error.what() + " (see --help)\n";
   });
+  // The only exceptions: CLI11 reports bad arguments with one, and anything the commands did not
+  // foresee (out of memory, say) ends here as an error line rather than an abort.
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
-    return app.exit(error) == 0 ? 0 : 2;
+    return app.exit(error) == 0 ? motwin::cli::kExitSuccess : motwin::cli::kExitUsageError;
+  } catch (const std::exception& unexpected) {
+    motwin::cli::print_error(unexpected.what());
+    return motwin::cli::kExitUsageError;
   }
   return exit_status;
 }

@@ -16,9 +16,10 @@
 //   output GPO0 1 at <sim seconds>                whenever an output changes
 // Errors before `ready`: one `motwin: error: ...` line on stderr, exit status 2.
 #include <algorithm>
+#include <charconv>
 #include <csignal>
 #include <cstdio>
-#include <exception>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -30,6 +31,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "cli/module_inputs.h"
 #include "host/can_bus.h"
 #include "host/can_capture.h"
 #include "host/can_device_endpoints.h"
@@ -46,6 +48,7 @@
 #include "host/tcp_server.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
+#include "types/result.h"
 
 namespace motwin::cli {
 namespace {
@@ -69,10 +72,6 @@ struct ServeArguments {
   std::string can_bitrate = "1M";
   double can_stats_s = 0;
   bool module_given = false;
-};
-
-struct ServeError {
-  std::string message;
 };
 
 void print_line(const std::string& line) {
@@ -122,26 +121,355 @@ std::string format_sim_seconds(uint64_t sim_time_us) {
   return buffer;
 }
 
-// "1M", "500k", "125000", "0" (no bus timing).
-std::optional<uint32_t> parse_bit_rate(const std::string& text) {
-  if (text.empty()) return std::nullopt;
-  uint64_t multiplier = 1;
-  std::string digits = text;
-  if (digits.back() == 'k' || digits.back() == 'K') multiplier = 1000;
-  if (digits.back() == 'M' || digits.back() == 'm') multiplier = 1'000'000;
-  if (multiplier != 1) digits.pop_back();
-  if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) {
-    return std::nullopt;
+// --- Checking the arguments ----------------------------------------------------------------------
+
+// The result, or its failure with `context` in front.
+template <class T>
+Result<T> with_context(Result<T> result, const std::string& context) {
+  if (!result) return result.error_with_context(context);
+  return result;
+}
+
+// Every text of a repeatable option parsed by `parse` (given the text and its 1-based
+// position), or the first failure.
+template <class T, class Parse>
+Result<std::vector<T>> parse_each(const std::vector<std::string>& texts, Parse parse) {
+  std::vector<T> parsed;
+  for (size_t i = 0; i < texts.size(); ++i) {
+    Result<T> one = parse(texts[i], i + 1);
+    if (!one) return Error{one.error()};
+    parsed.push_back(std::move(*one));
   }
-  const uint64_t value = std::stoull(digits) * multiplier;
-  if (value > 1'000'000) return std::nullopt;  // classic CAN ends at 1 Mbit/s
-  return static_cast<uint32_t>(value);
+  return parsed;
+}
+
+// What runs: one module (--module) or several on one bus (--node), with their options.
+struct ModulePlan {
+  const host::ModuleDescriptor* descriptor = nullptr;  // --module (with --node: the nodes' own)
+  std::vector<host::NodeSpec> nodes;
+  host::Pacing pacing;
+  host::ModuleOptions options;  // with --node only the state directory applies
+  std::optional<std::vector<sim::ScenarioEvent>> scenario;
+};
+
+// Where it is served.
+struct EndpointPlan {
+  std::vector<host::TcpEndpointSpec> tmcl_tcp;
+  std::string tmcl_pty_link;
+  std::vector<host::CanEndpointSpec> can;
+  uint32_t can_bit_rate = 0;
+  std::string can_capture;  // a file; empty: none
+  double can_stats_s = 0;   // 0: no can-stats lines
+};
+
+struct ServePlan {
+  ModulePlan module;
+  EndpointPlan endpoints;
+};
+
+// --state-dir: a directory, none (nullopt: the image stays in memory) or, not given, the default.
+Result<std::optional<std::filesystem::path>> state_dir_of(const std::string& state_dir) {
+  if (state_dir == host::kNoStateDir) return std::optional<std::filesystem::path>{};
+  if (!state_dir.empty()) return std::optional<std::filesystem::path>{state_dir};
+  if (std::optional<std::filesystem::path> default_dir = host::default_state_dir()) return default_dir;
+  return Error{"no home directory for the default state directory; give --state-dir DIR (or none)"};
+}
+
+// --node puts several modules on one bus: they speak CAN only (docs/canopen.md), and each node
+// takes its own options.
+Result<void> check_node_options(const ServeArguments& arguments) {
+  if (arguments.nodes.empty()) return {};
+  if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty() || !arguments.assignments.empty() ||
+      !arguments.scenario_path.empty() || arguments.node_id != 0 || arguments.motor != "ideal" || arguments.module_given) {
+    return Error{"--node cannot be combined with --module, --tmcl-tcp, --tmcl-pty, --set, --scenario, --motor or "
+                 "--node-id (give per-node options: --node tmcm-3216:node-id=2)"};
+  }
+  return {};
+}
+
+Result<ModulePlan> check_module_arguments(const ServeArguments& arguments) {
+  ModulePlan plan;
+  plan.descriptor = host::find_module(arguments.module);
+  if (plan.descriptor == nullptr) {
+    return Error{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
+  }
+  const Result<host::Pacing> pacing = host::Pacing::parse(arguments.speed);
+  if (!pacing) return Error{pacing.error()};
+  plan.pacing = *pacing;
+  Result<ModuleInputs> inputs =
+      read_module_inputs(plan.descriptor->input_signals(), arguments.assignments, arguments.scenario_path);
+  if (!inputs) return Error{inputs.error()};
+  plan.options.initial_inputs = std::move(inputs->initial_inputs);
+  plan.scenario = std::move(inputs->scenario);
+  plan.options.motor = arguments.motor;
+  plan.options.node_id = static_cast<uint8_t>(arguments.node_id);
+  Result<std::optional<std::filesystem::path>> state_dir = state_dir_of(arguments.state_dir);
+  if (!state_dir) return Error{state_dir.error()};
+  plan.options.state_dir = *state_dir;
+  Result<std::vector<host::NodeSpec>> nodes =
+      parse_each<host::NodeSpec>(arguments.nodes, [](const std::string& text, size_t position) {
+        return with_context(host::parse_node_spec(text, position), "--node " + text + ": ");
+      });
+  if (!nodes) return Error{nodes.error()};
+  plan.nodes = std::move(*nodes);
+  return plan;
+}
+
+// "1M", "500k", "125000", "0" (no bus timing).
+Result<uint32_t> parse_bit_rate(std::string_view text) {
+  const Error expected{"--can-bitrate: expected bit/s such as 1M, 500k, 125000 or 0, got \"" + std::string(text) +
+                       "\""};
+  if (text.empty()) return expected;
+  uint64_t multiplier = 1;
+  if (text.back() == 'k' || text.back() == 'K') multiplier = 1000;
+  if (text.back() == 'M' || text.back() == 'm') multiplier = 1'000'000;
+  std::string_view digits = multiplier == 1 ? text : text.substr(0, text.size() - 1);
+  uint64_t value = 0;
+  const auto [end, problem] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (digits.empty() || digits.size() > 9 || problem != std::errc{} || end != digits.data() + digits.size()) {
+    return expected;
+  }
+  if (value * multiplier > 1'000'000) return expected;  // classic CAN ends at 1 Mbit/s
+  return static_cast<uint32_t>(value * multiplier);
+}
+
+// A single module is served only on the interfaces its firmware has.
+Result<void> check_offered(const host::ModuleDescriptor& module, const EndpointPlan& plan) {
+  const host::ModuleEndpoints& offered = module.endpoints;
+  if ((!plan.tmcl_tcp.empty() && !offered.tmcl_tcp) || (!plan.tmcl_pty_link.empty() && !offered.tmcl_pty)) {
+    return Error{std::string(module.name) + " has no TMCL interface" +
+                 (offered.canopen ? " (its firmware speaks CANopen): use --can" : " on TCP or a pty")};
+  }
+  if (!plan.can.empty() && !offered.has_can()) return Error{std::string(module.name) + " has no CAN interface (--can)"};
+  return {};
+}
+
+Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, const ModulePlan& module) {
+  EndpointPlan plan;
+  Result<std::vector<host::TcpEndpointSpec>> tcp =
+      parse_each<host::TcpEndpointSpec>(arguments.tcp_endpoints, [](const std::string& text, size_t) {
+        return with_context(host::parse_tcp_endpoint(text), "--tmcl-tcp: ");
+      });
+  if (!tcp) return Error{tcp.error()};
+  plan.tmcl_tcp = std::move(*tcp);
+  plan.tmcl_pty_link = arguments.pty_link;
+  Result<std::vector<host::CanEndpointSpec>> can =
+      parse_each<host::CanEndpointSpec>(arguments.can_endpoints, [](const std::string& text, size_t) {
+        return with_context(host::parse_can_endpoint(text), "--can: ");
+      });
+  if (!can) return Error{can.error()};
+  plan.can = std::move(*can);
+  if (plan.tmcl_tcp.empty() && plan.tmcl_pty_link.empty() && plan.can.empty()) {
+    // Nodes are on the bus; a single module where its descriptor puts it.
+    if (module.nodes.empty() && module.descriptor->endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
+      plan.tmcl_tcp.push_back(host::TcpEndpointSpec{});  // 127.0.0.1:5000
+    } else {
+      plan.can.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
+    }
+  }
+  Result<uint32_t> bit_rate = parse_bit_rate(arguments.can_bitrate);
+  if (!bit_rate) return Error{bit_rate.error()};
+  plan.can_bit_rate = *bit_rate;
+  if (Result<void> combined = check_node_options(arguments); !combined) return Error{combined.error()};
+  if (module.nodes.empty()) {
+    if (Result<void> offered = check_offered(*module.descriptor, plan); !offered) return Error{offered.error()};
+  }
+  // These watch the bus.
+  if (plan.can.empty() && !arguments.can_capture.empty()) return Error{"--can-capture needs a CAN bus (--can)"};
+  if (plan.can.empty() && arguments.can_stats_s > 0) return Error{"--can-stats needs a CAN bus (--can)"};
+  plan.can_capture = arguments.can_capture;
+  plan.can_stats_s = arguments.can_stats_s;
+  return plan;
+}
+
+// Everything the user typed, checked before any file or socket is touched.
+Result<ServePlan> check_arguments(const ServeArguments& arguments) {
+  Result<ModulePlan> module = check_module_arguments(arguments);
+  if (!module) return Error{module.error()};
+  Result<EndpointPlan> endpoints = check_endpoint_arguments(arguments, *module);
+  if (!endpoints) return Error{endpoints.error()};
+  return ServePlan{std::move(*module), std::move(*endpoints)};
+}
+
+// --- The module, the bus and the endpoints ------------------------------------------------------
+
+using NamedBusNode = std::pair<std::string, host::CanBusNode*>;
+
+// What `serve` runs: one module, or with --node a group of them on one bus.
+struct ServedModule {
+  std::unique_ptr<host::VirtualModule> module;
+  host::ModuleGroup* group = nullptr;  // the same object, when it is a group
+
+  // The modules that join the CAN bus, with the names --can-stats gives them.
+  std::vector<NamedBusNode> bus_nodes() const {
+    if (group == nullptr) return {NamedBusNode{std::string(module->name()), module->can_node()}};
+    std::vector<NamedBusNode> nodes;
+    for (host::ModuleGroup::Member& member : group->members()) {
+      nodes.emplace_back(member.name, member.module->can_node());
+    }
+    return nodes;
+  }
+
+  // The first lines on stdout: the module, or each node, with its firmware and EEPROM image.
+  std::vector<std::string> banner_lines() const {
+    if (group == nullptr) {
+      return {"motwin: " + std::string(module->name()) + " (" + std::string(module->firmware_version()) +
+              ") eeprom " + module->nvm_location()};
+    }
+    std::vector<std::string> lines;
+    for (host::ModuleGroup::Member& member : group->members()) {
+      lines.push_back("motwin: node " + member.name + " " + std::string(member.module->name()) + " (" +
+                      std::string(member.module->firmware_version()) + ") eeprom " + member.module->nvm_location());
+    }
+    return lines;
+  }
+};
+
+Result<ServedModule> make_served_module(const ModulePlan& plan) {
+  if (plan.nodes.empty()) {
+    Result<std::unique_ptr<host::VirtualModule>> module = plan.descriptor->make(plan.options);
+    if (!module) return Error{module.error()};
+    return ServedModule{std::move(*module)};
+  }
+  Result<std::unique_ptr<host::ModuleGroup>> group = host::ModuleGroup::make(plan.nodes, plan.options.state_dir);
+  if (!group) return Error{group.error()};
+  host::ModuleGroup* members = group->get();
+  return ServedModule{std::move(*group), members};
+}
+
+// The virtual CAN bus, stamped with simulated time, with the modules and a capture on it. What
+// joined leaves before the bus goes: the capture, then the modules (which outlive it). Endpoints
+// on the bus must be closed before this goes.
+class ServedCanBus {
+ public:
+  ServedCanBus(host::VirtualModule& clock, uint32_t bit_rate) : bus_([&clock] { return clock.sim_time_us(); }) {
+    bus_.set_bit_rate(bit_rate);
+  }
+  ServedCanBus(const ServedCanBus&) = delete;
+  ServedCanBus& operator=(const ServedCanBus&) = delete;
+  ~ServedCanBus() {
+    if (capture_id_ != 0) bus_.detach(capture_id_);
+    capture_.reset();
+    for (const auto& [name, node] : nodes_) node->disconnect();
+  }
+
+  void join(std::vector<NamedBusNode> nodes) {
+    nodes_ = std::move(nodes);
+    for (const auto& [name, node] : nodes_) node->connect(bus_);
+  }
+  // --can-capture FILE.
+  Result<void> capture_to(const std::string& path) {
+    Result<std::unique_ptr<host::CanCapture>> opened = host::CanCapture::open(path);
+    if (!opened) return opened.error_with_context("--can-capture: ");
+    capture_ = std::move(*opened);
+    capture_id_ = bus_.attach(*capture_);
+    return {};
+  }
+
+  host::CanBus& bus() { return bus_; }
+  const std::vector<NamedBusNode>& nodes() const { return nodes_; }
+
+ private:
+  host::CanBus bus_;
+  std::vector<NamedBusNode> nodes_;
+  std::unique_ptr<host::CanCapture> capture_;
+  host::CanBus::EndpointId capture_id_ = 0;
+};
+
+// An endpoint, open for as long as this lives, with its line for stdout ("endpoint tmcl-tcp ...").
+struct OpenEndpoint {
+  std::shared_ptr<void> endpoint;
+  std::string line;
+};
+
+// Each kind of endpoint says where it is: an address, or a link and its device.
+std::string where(const host::TmclTcpServer& server) { return server.local_address(); }
+std::string where(const host::SocketcandServer& server) { return server.local_address(); }
+std::string where(const host::SlcanTcpServer& server) { return server.local_address(); }
+std::string where(const host::SocketcanEndpoint& can) { return can.interface_name(); }
+std::string where(const host::TmclPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
+std::string where(const host::SlcanPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
+
+// `opened` with its line "endpoint KIND WHERE", or its failure with `context` in front.
+template <class Endpoint>
+Result<OpenEndpoint> keep_open(Result<std::unique_ptr<Endpoint>> opened, std::string_view kind,
+                               const std::string& context) {
+  if (!opened) return opened.error_with_context(context);
+  std::string line = "endpoint " + std::string(kind) + " " + where(**opened);
+  return OpenEndpoint{std::shared_ptr<Endpoint>(std::move(*opened)), std::move(line)};
+}
+
+Result<OpenEndpoint> open_can_endpoint(host::EventLoop& loop, host::CanBus& bus, const host::CanEndpointSpec& spec) {
+  switch (spec.transport) {
+    case host::CanTransport::kSlcanPty:
+      return keep_open(host::SlcanPtyEndpoint::open(loop, bus, spec.device), "can-slcan-pty",
+                       "--can slcan:" + spec.device + ": ");
+    case host::CanTransport::kSocketcan:
+      return keep_open(host::SocketcanEndpoint::open(loop, bus, spec.device), "can-socketcan", "--can: ");
+    case host::CanTransport::kSlcanTcp:
+      return keep_open(host::SlcanTcpServer::open(loop, bus, spec.tcp), "can-slcan-tcp", "--can: ");
+    case host::CanTransport::kSocketcand:
+      break;
+  }
+  return keep_open(host::SocketcandServer::open(loop, bus, spec.tcp), "can-socketcand", "--can: ");
+}
+
+// TMCL over TCP (--tmcl-tcp) and on a pseudo-terminal (--tmcl-pty).
+Result<std::vector<OpenEndpoint>> open_tmcl_endpoints(host::HostRuntime& runtime, const EndpointPlan& plan) {
+  std::vector<OpenEndpoint> endpoints;
+  for (const host::TcpEndpointSpec& spec : plan.tmcl_tcp) {
+    Result<OpenEndpoint> opened =
+        keep_open(host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec), "tmcl-tcp", "");
+    if (!opened) return Error{opened.error()};
+    endpoints.push_back(std::move(*opened));
+  }
+  if (!plan.tmcl_pty_link.empty()) {
+    Result<OpenEndpoint> opened =
+        keep_open(host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), plan.tmcl_pty_link), "tmcl-pty", "");
+    if (!opened) return Error{opened.error()};
+    endpoints.push_back(std::move(*opened));
+  }
+  return endpoints;
+}
+
+// The endpoints of the plan in the order of their lines: TMCL over TCP and on a pty, then, once
+// the modules are on the bus and its capture runs, the CAN endpoints. On a failure the ones
+// already open close again.
+Result<std::vector<OpenEndpoint>> open_endpoints(host::HostRuntime& runtime, ServedCanBus& can,
+                                                 const ServedModule& served, const EndpointPlan& plan) {
+  Result<std::vector<OpenEndpoint>> endpoints = open_tmcl_endpoints(runtime, plan);
+  if (!endpoints || plan.can.empty()) return endpoints;
+  can.join(served.bus_nodes());
+  if (!plan.can_capture.empty()) {
+    if (Result<void> capture = can.capture_to(plan.can_capture); !capture) return Error{capture.error()};
+  }
+  for (const host::CanEndpointSpec& spec : plan.can) {
+    Result<OpenEndpoint> opened = open_can_endpoint(runtime.loop(), can.bus(), spec);
+    if (!opened) return Error{opened.error()};
+    endpoints->push_back(std::move(*opened));
+  }
+  return endpoints;
+}
+
+// --- Reports while running ----------------------------------------------------------------------
+
+using Report = std::shared_ptr<std::function<void()>>;
+
+// Runs `report` every `period_us` for as long as the returned handle lives.
+Report repeat_every(host::EventLoop& loop, uint64_t period_us, std::function<void()> report) {
+  Report repeating = std::make_shared<std::function<void()>>();
+  *repeating = [&loop, period_us, report = std::move(report), weak = std::weak_ptr(repeating)] {
+    report();
+    if (const Report again = weak.lock()) loop.add_timer_after(period_us, *again);
+  };
+  loop.add_timer_after(period_us, *repeating);
+  return repeating;
 }
 
 // One `can-stats` line for the interval since `before` (`interval_us` of simulated time).
 // Nodes that are or were off speed (or lost frames) follow, one " node NAME ..." part each.
 std::string format_can_stats(host::CanBus& bus, const host::CanBusStats& before, uint64_t interval_us,
-                             const std::vector<std::pair<std::string, host::CanBusNode*>>& nodes) {
+                             const std::vector<NamedBusNode>& nodes) {
   const host::CanBusStats& now = bus.stats();
   const uint64_t frames = now.frames - before.frames;
   const double load = interval_us == 0 ? 0.0
@@ -164,263 +492,76 @@ std::string format_can_stats(host::CanBus& bus, const host::CanBusStats& before,
   return text;
 }
 
-int run_serve(const ServeArguments& arguments) {
-  std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  ShutdownSignals shutdown_signals;
-  if (shutdown_signals.fd() < 0) throw ServeError{"cannot set up signal handling"};
-
-  // Everything the user typed is checked before any file or socket is touched.
-  const host::ModuleDescriptor* descriptor = host::find_module(arguments.module);
-  if (descriptor == nullptr) {
-    throw ServeError{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
-  }
-  const Result<host::Pacing> pacing = host::Pacing::parse(arguments.speed);
-  if (!pacing) throw ServeError{pacing.error()};
-  // The crash-point test hook, before any image is opened: opening may already write one.
-  if (const Result<void> hook = host::install_persist_crash_hook_from_environment(); !hook) {
-    throw ServeError{hook.error()};
-  }
-
-  host::ModuleOptions options;
-  options.motor = arguments.motor;
-  for (const std::string& text : arguments.assignments) {
-    const Result<sim::SignalAssignment> assignment = sim::parse_signal_assignment(descriptor->input_signals(), text);
-    if (!assignment) throw ServeError{"--set " + text + ": " + assignment.error()};
-    options.initial_inputs.push_back(host::InitialInput{std::string(assignment->signal->name), assignment->value});
-  }
-  std::optional<std::vector<sim::ScenarioEvent>> scenario;
-  if (!arguments.scenario_path.empty()) {
-    Result<std::vector<sim::ScenarioEvent>> events =
-        sim::load_scenario_file(arguments.scenario_path, descriptor->input_signals());
-    if (!events) throw ServeError{events.error()};
-    scenario = std::move(*events);
-  }
-  std::vector<host::TcpEndpointSpec> tcp_specs;
-  for (const std::string& text : arguments.tcp_endpoints) {
-    const Result<host::TcpEndpointSpec> spec = host::parse_tcp_endpoint(text);
-    if (!spec) throw ServeError{"--tmcl-tcp: " + spec.error()};
-    tcp_specs.push_back(*spec);
-  }
-  std::vector<host::CanEndpointSpec> can_specs;
-  for (const std::string& text : arguments.can_endpoints) {
-    const Result<host::CanEndpointSpec> spec = host::parse_can_endpoint(text);
-    if (!spec) throw ServeError{"--can: " + spec.error()};
-    can_specs.push_back(*spec);
-  }
-  options.node_id = static_cast<uint8_t>(arguments.node_id);
-  if (tcp_specs.empty() && arguments.pty_link.empty() && can_specs.empty()) {
-    if (descriptor->endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
-      tcp_specs.push_back(host::TcpEndpointSpec{});  // 127.0.0.1:5000
-    } else {
-      can_specs.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
-    }
-  }
-
-  if (arguments.state_dir != host::kNoStateDir) {
-    if (!arguments.state_dir.empty()) {
-      options.state_dir = arguments.state_dir;
-    } else if (std::optional<std::filesystem::path> default_dir = host::default_state_dir()) {
-      options.state_dir = *default_dir;
-    } else {
-      throw ServeError{"no home directory for the default state directory; give --state-dir DIR (or none)"};
-    }
-  }
-  std::vector<host::NodeSpec> node_specs;
-  for (size_t i = 0; i < arguments.nodes.size(); ++i) {
-    const Result<host::NodeSpec> spec = host::parse_node_spec(arguments.nodes[i], i + 1);
-    if (!spec) throw ServeError{"--node " + arguments.nodes[i] + ": " + spec.error()};
-    node_specs.push_back(*spec);
-  }
-  const std::optional<uint32_t> bit_rate = parse_bit_rate(arguments.can_bitrate);
-  if (!bit_rate) throw ServeError{"--can-bitrate: expected bit/s such as 1M, 500k, 125000 or 0, got \"" +
-                                  arguments.can_bitrate + "\""};
-
-  std::unique_ptr<host::VirtualModule> owned_module;
-  host::ModuleGroup* group = nullptr;
-  if (!node_specs.empty()) {
-    // Several modules on one bus: they speak CAN only (docs/canopen.md).
-    if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty() || !arguments.assignments.empty() ||
-        !arguments.scenario_path.empty() || arguments.node_id != 0 || arguments.motor != "ideal" || arguments.module_given) {
-      throw ServeError{"--node cannot be combined with --module, --tmcl-tcp, --tmcl-pty, --set, --scenario, --motor or "
-                       "--node-id (give per-node options: --node tmcm-3216:node-id=2)"};
-    }
-    tcp_specs.clear();
-    if (can_specs.empty()) can_specs.push_back(host::CanEndpointSpec{});
-    Result<std::unique_ptr<host::ModuleGroup>> made = host::ModuleGroup::make(node_specs, options.state_dir);
-    if (!made) throw ServeError{made.error()};
-    group = made->get();
-    owned_module = std::move(*made);
-  } else {
-    host::MakeModuleResult made = descriptor->make(options);
-    if (!made) throw ServeError{made.error()};
-    owned_module = std::move(*made);
-  }
-  host::VirtualModule& module = *owned_module;
-  if (group == nullptr) {
-    const host::ModuleEndpoints& offered = descriptor->endpoints;
-    if ((!tcp_specs.empty() && !offered.tmcl_tcp) || (!arguments.pty_link.empty() && !offered.tmcl_pty)) {
-      throw ServeError{std::string(module.name()) + " has no TMCL interface" +
-                       (offered.canopen ? " (its firmware speaks CANopen): use --can" : " on TCP or a pty")};
-    }
-    if (!can_specs.empty() && !offered.has_can()) {
-      throw ServeError{std::string(module.name()) + " has no CAN interface (--can)"};
-    }
-  }
-
-  host::HostRuntime runtime(module, *pacing);
-  if (scenario) runtime.set_scenario(std::move(*scenario));
-
-  // Endpoints are destroyed before the runtime they are attached to.
-  std::vector<std::unique_ptr<host::TmclTcpServer>> tcp_servers;
-  for (const host::TcpEndpointSpec& spec : tcp_specs) {
-    Result<std::unique_ptr<host::TmclTcpServer>> opened =
-        host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec);
-    if (!opened) throw ServeError{opened.error()};
-    tcp_servers.push_back(std::move(*opened));
-  }
-  std::unique_ptr<host::TmclPtyEndpoint> pty;
-  if (!arguments.pty_link.empty()) {
-    Result<std::unique_ptr<host::TmclPtyEndpoint>> opened =
-        host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), arguments.pty_link);
-    if (!opened) throw ServeError{opened.error()};
-    pty = std::move(*opened);
-  }
-  // The virtual CAN bus, stamped with simulated time; the modules leave it before they go away.
-  host::CanBus can_bus([&module] { return module.sim_time_us(); });
-  can_bus.set_bit_rate(*bit_rate);
-  struct BusMembership {
-    std::vector<host::CanBusNode*> nodes;
-    std::vector<std::pair<std::string, host::CanBusNode*>> named;  // for --can-stats
-    ~BusMembership() {
-      for (host::CanBusNode* node : nodes) node->disconnect();
-    }
-  } bus_membership;
-  if (!can_specs.empty()) {
-    if (group != nullptr) {
-      for (host::ModuleGroup::Member& member : group->members()) {
-        bus_membership.nodes.push_back(member.module->can_node());
-        bus_membership.named.emplace_back(member.name, member.module->can_node());
-      }
-    } else {
-      bus_membership.nodes.push_back(module.can_node());
-      bus_membership.named.emplace_back(std::string(module.name()), module.can_node());
-    }
-    for (host::CanBusNode* node : bus_membership.nodes) node->connect(can_bus);
-  }
-  std::unique_ptr<host::CanCapture> can_capture;
-  struct CaptureMembership {
-    host::CanBus& bus;
-    host::CanBus::EndpointId id = 0;
-    ~CaptureMembership() {
-      if (id != 0) bus.detach(id);
-    }
-  } capture_membership{can_bus};
-  if (!arguments.can_capture.empty()) {
-    if (can_specs.empty()) throw ServeError{"--can-capture needs a CAN bus (--can)"};
-    Result<std::unique_ptr<host::CanCapture>> opened = host::CanCapture::open(arguments.can_capture);
-    if (!opened) throw ServeError{"--can-capture: " + opened.error()};
-    can_capture = std::move(*opened);
-    capture_membership.id = can_bus.attach(*can_capture);
-  }
-  std::vector<std::unique_ptr<host::SocketcandServer>> can_servers;
-  std::vector<std::unique_ptr<host::SlcanTcpServer>> slcan_servers;
-  std::vector<std::unique_ptr<host::SlcanPtyEndpoint>> slcan_ptys;
-  std::vector<std::unique_ptr<host::SocketcanEndpoint>> socketcan_endpoints;
-  std::vector<std::string> can_endpoint_lines;
-  for (const host::CanEndpointSpec& spec : can_specs) {
-    if (spec.transport == host::CanTransport::kSlcanPty) {
-      Result<std::unique_ptr<host::SlcanPtyEndpoint>> opened =
-          host::SlcanPtyEndpoint::open(runtime.loop(), can_bus, spec.device);
-      if (!opened) throw ServeError{"--can slcan:" + spec.device + ": " + opened.error()};
-      can_endpoint_lines.push_back("endpoint can-slcan-pty " + (*opened)->link_path() + " " + (*opened)->device_path());
-      slcan_ptys.push_back(std::move(*opened));
-      continue;
-    }
-    if (spec.transport == host::CanTransport::kSocketcan) {
-      Result<std::unique_ptr<host::SocketcanEndpoint>> opened =
-          host::SocketcanEndpoint::open(runtime.loop(), can_bus, spec.device);
-      if (!opened) throw ServeError{"--can: " + opened.error()};
-      can_endpoint_lines.push_back("endpoint can-socketcan " + (*opened)->interface_name());
-      socketcan_endpoints.push_back(std::move(*opened));
-      continue;
-    }
-    if (spec.transport == host::CanTransport::kSlcanTcp) {
-      Result<std::unique_ptr<host::SlcanTcpServer>> opened =
-          host::SlcanTcpServer::open(runtime.loop(), can_bus, spec.tcp);
-      if (!opened) throw ServeError{"--can: " + opened.error()};
-      can_endpoint_lines.push_back("endpoint can-slcan-tcp " + (*opened)->local_address());
-      slcan_servers.push_back(std::move(*opened));
-      continue;
-    }
-    Result<std::unique_ptr<host::SocketcandServer>> opened =
-        host::SocketcandServer::open(runtime.loop(), can_bus, spec.tcp);
-    if (!opened) throw ServeError{"--can: " + opened.error()};
-    can_endpoint_lines.push_back("endpoint can-socketcand " + (*opened)->local_address());
-    can_servers.push_back(std::move(*opened));
-  }
-
-  std::shared_ptr<std::function<void()>> stats_reporter;
+// "output GPO0 1 at <sim seconds>" on stdout for each output change; on stderr, at most every
+// kLagReportIntervalUs, that the simulation cannot keep up with --speed; and every
+// `can_stats_s` a `can-stats` line. The reports stop when the returned handles go.
+std::vector<Report> start_reports(host::HostRuntime& runtime, ServedCanBus& can, double can_stats_s) {
   runtime.set_output_listener([](const sim::OutputChange& change) {
     print_line("output " + std::string(change.signal) + " " + std::to_string(change.level) + " at " +
                format_sim_seconds(change.sim_time_us));
   });
+  const auto report_lag = [&runtime, reported_lag_us = std::make_shared<uint64_t>(0)] {
+    const uint64_t dropped_us = runtime.pacer().dropped_backlog_sim_us();
+    if (dropped_us > *reported_lag_us) {
+      std::fprintf(stderr, "motwin: the simulation cannot keep up with --speed %s; it now lags %.1f ms of sim time\n",
+                   runtime.pacer().pacing().describe().c_str(), static_cast<double>(dropped_us) / 1000.0);
+      *reported_lag_us = dropped_us;
+    }
+  };
+  std::vector<Report> reports{repeat_every(runtime.loop(), kLagReportIntervalUs, report_lag)};
+  if (can_stats_s > 0) {
+    host::VirtualModule& module = runtime.module();
+    // The bus totals and the simulated time of the previous line.
+    auto previous = std::make_shared<std::pair<host::CanBusStats, uint64_t>>(can.bus().stats(), module.sim_time_us());
+    const auto report_can_stats = [&can, &module, previous] {
+      print_line(format_can_stats(can.bus(), previous->first, module.sim_time_us() - previous->second, can.nodes()));
+      *previous = {can.bus().stats(), module.sim_time_us()};
+    };
+    reports.push_back(repeat_every(runtime.loop(), static_cast<uint64_t>(can_stats_s * 1e6), report_can_stats));
+  }
+  return reports;
+}
+
+// SIGINT or SIGTERM ends runtime.run() between two loop iterations.
+void stop_on_shutdown_signals(host::HostRuntime& runtime, const ShutdownSignals& shutdown_signals) {
   runtime.loop().watch(shutdown_signals.fd(), POLLIN, [&runtime, &shutdown_signals](short) {
     signalfd_siginfo info{};
     while (::read(shutdown_signals.fd(), &info, sizeof(info)) == static_cast<ssize_t>(sizeof(info))) {
     }
     runtime.loop().request_stop();
   });
-  uint64_t reported_lag_us = 0;
-  std::function<void()> report_lag = [&] {
-    const uint64_t dropped_us = runtime.pacer().dropped_backlog_sim_us();
-    if (dropped_us > reported_lag_us) {
-      std::fprintf(stderr, "motwin: the simulation cannot keep up with --speed %s; it now lags %.1f ms of sim time\n",
-                   runtime.pacer().pacing().describe().c_str(), static_cast<double>(dropped_us) / 1000.0);
-      reported_lag_us = dropped_us;
-    }
-    runtime.loop().add_timer_after(kLagReportIntervalUs, report_lag);
-  };
-  runtime.loop().add_timer_after(kLagReportIntervalUs, report_lag);
+}
 
-  if (group != nullptr) {
-    for (host::ModuleGroup::Member& member : group->members()) {
-      print_line("motwin: node " + member.name + " " + std::string(member.module->name()) + " (" +
-                 std::string(member.module->firmware_version()) + ") eeprom " + member.module->nvm_location());
-    }
-  } else {
-    print_line("motwin: " + std::string(module.name()) + " (" + std::string(module.firmware_version()) + ") eeprom " +
-               module.nvm_location());
+int run_serve(const ServeArguments& arguments) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  ShutdownSignals shutdown_signals;
+  if (shutdown_signals.fd() < 0) return usage_error("cannot set up signal handling");
+  Result<ServePlan> plan = check_arguments(arguments);
+  if (!plan) return usage_error(plan.error());
+  // The crash-point test hook, before any image is opened: opening may already write one.
+  if (const Result<void> hook = host::install_persist_crash_hook_from_environment(); !hook) {
+    return usage_error(hook.error());
   }
-  if (arguments.can_stats_s > 0) {
-    if (can_specs.empty()) throw ServeError{"--can-stats needs a CAN bus (--can)"};
-    const uint64_t period_us = static_cast<uint64_t>(arguments.can_stats_s * 1e6);
-    auto previous = std::make_shared<std::pair<host::CanBusStats, uint64_t>>(can_bus.stats(), module.sim_time_us());
-    std::shared_ptr<std::function<void()>> report_stats = std::make_shared<std::function<void()>>();
-    *report_stats = [&runtime, &can_bus, &module, &bus_membership, previous, period_us,
-                     weak = std::weak_ptr(report_stats)] {
-      print_line(format_can_stats(can_bus, previous->first, module.sim_time_us() - previous->second,
-                                  bus_membership.named));
-      *previous = {can_bus.stats(), module.sim_time_us()};
-      if (const auto again = weak.lock()) runtime.loop().add_timer_after(period_us, *again);
-    };
-    stats_reporter = report_stats;
-    runtime.loop().add_timer_after(period_us, *report_stats);
-  }
-  for (const auto& server : tcp_servers) print_line("endpoint tmcl-tcp " + server->local_address());
-  if (pty) print_line("endpoint tmcl-pty " + pty->link_path() + " " + pty->device_path());
-  for (const std::string& line : can_endpoint_lines) print_line(line);
+  Result<ServedModule> served = make_served_module(plan->module);
+  if (!served) return usage_error(served.error());
+  host::VirtualModule& module = *served->module;
+  host::HostRuntime runtime(module, plan->module.pacing);
+  if (plan->module.scenario) runtime.set_scenario(std::move(*plan->module.scenario));
+  ServedCanBus can(module, plan->endpoints.can_bit_rate);
+  // After the runtime and the bus: the endpoints close before them.
+  Result<std::vector<OpenEndpoint>> endpoints = open_endpoints(runtime, can, *served, plan->endpoints);
+  if (!endpoints) return usage_error(endpoints.error());
+  const std::vector<Report> reports = start_reports(runtime, can, plan->endpoints.can_stats_s);
+  stop_on_shutdown_signals(runtime, shutdown_signals);
+
+  for (const std::string& line : served->banner_lines()) print_line(line);
+  for (const OpenEndpoint& endpoint : *endpoints) print_line(endpoint.line);
   runtime.start();
   print_line("ready");
-
   runtime.run();
 
   runtime.loop().unwatch(shutdown_signals.fd());
-  pty.reset();
-  tcp_servers.clear();
-  can_servers.clear();
-  slcan_servers.clear();
-  slcan_ptys.clear();
-  socketcan_endpoints.clear();
+  endpoints->clear();
   return kExitSuccess;
 }
 
@@ -584,15 +725,7 @@ void add_serve_command(CLI::App& app, int& exit_status) {
 
   serve->callback([arguments, module_option, &exit_status] {
     arguments->module_given = module_option->count() > 0;
-    try {
-      exit_status = run_serve(*arguments);
-    } catch (const ServeError& serve_error) {
-      print_error(serve_error.message);
-      exit_status = kExitUsageError;
-    } catch (const std::exception& unexpected) {
-      print_error(unexpected.what());
-      exit_status = kExitUsageError;
-    }
+    exit_status = run_serve(*arguments);
   });
 }
 
