@@ -35,24 +35,20 @@ std::string describe(const tmcl::Instruction& in) {
 }
 
 int run_download(const DownloadOptions& options) {
-  int exit_status = kExitSuccess;
-  const std::optional<LoadedProgram> program = load_program(options.program, options.include_dirs, exit_status);
-  if (!program) return exit_status;
+  const Result<LoadedProgram> program = load_program(options.program, options.include_dirs);
+  if (!program) return usage_error(program.error());
+  if (program->has_errors()) return report_program_errors(*program, options.program);
   if (program->instructions.empty()) {
     print_error(fmt::format("{} holds no instruction", options.program));
     return kExitProgramError;
   }
   Result<tools::TmclClient> client = connect(options.connection);
-  if (!client) {
-    print_error(client.error());
-    return kExitUsageError;
-  }
+  if (!client) return usage_error(client.error());
   const uint8_t address = options.connection.address();
   const Result<size_t> downloaded =
       tools::download_program(client.value(), program->instructions, options.start, address);
   if (!downloaded) {
-    print_error(fmt::format("download to {} failed: {}", client->peer_name(), downloaded.error()));
-    return kExitUsageError;
+    return usage_error(fmt::format("download to {} failed: {}", client->peer_name(), downloaded.error()));
   }
   const size_t count = program->instructions.size();
   const uint32_t last = options.start + static_cast<uint32_t>(count) - 1;
@@ -65,8 +61,8 @@ int run_download(const DownloadOptions& options) {
   const Result<std::vector<tmcl::Instruction>> stored =
       tools::read_program(client.value(), options.start, static_cast<uint32_t>(count), address);
   if (!stored) {
-    print_error(fmt::format("downloaded, but reading it back from {} failed: {}", client->peer_name(), stored.error()));
-    return kExitUsageError;
+    return usage_error(
+        fmt::format("downloaded, but reading it back from {} failed: {}", client->peer_name(), stored.error()));
   }
   size_t mismatches = 0;
   for (size_t i = 0; i < count; ++i) {

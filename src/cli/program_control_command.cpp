@@ -1,6 +1,7 @@
 // `motwin start|stop|step|status`: control the stored TMCL program of a module with the control
 // commands of the TMCM-1636 manual table 10 (129 run, 128 stop, 130 step, 135 application
 // status), over TCP or a serial line (docs/tmcl-programs.md).
+#include <array>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -22,20 +23,16 @@ namespace {
 
 namespace cmd = tmcl::command;
 
-// Sends one control command; prints the error and returns std::nullopt unless status 100.
-std::optional<tools::TmclReply> control(tools::TmclClient& client, const ModuleConnection& connection,
-                                        const tmcl::Instruction& request, const std::string& what) {
-  const Result<tools::TmclReply> reply = client.request(request, connection.address());
-  if (!reply) {
-    print_error(fmt::format("{}: {}", what, reply.error()));
-    return std::nullopt;
-  }
+// Sends one control command: its reply, or an error unless the module answers status 100.
+Result<tools::TmclReply> control(tools::TmclClient& client, const ModuleConnection& connection,
+                                 const tmcl::Instruction& request, const std::string& what) {
+  Result<tools::TmclReply> reply = client.request(request, connection.address());
+  if (!reply) return reply.error_with_context(what + ": ");
   if (reply->status != tmcl::to_byte(tmcl::Status::kOk)) {
-    print_error(fmt::format("{}: the module answered status {} ({})", what, reply->status,
-                            tmcl::status_name(reply->status)));
-    return std::nullopt;
+    return Error{fmt::format("{}: the module answered status {} ({})", what, reply->status,
+                             tmcl::status_name(reply->status))};
   }
-  return reply.value();
+  return reply;
 }
 
 // --- start --------------------------------------------------------------------------------------
@@ -51,35 +48,28 @@ struct StartOptions {
 
 int run_start(const StartOptions& options) {
   const int choices = (options.address ? 1 : 0) + (options.label.empty() ? 0 : 1) + (options.resume ? 1 : 0);
-  if (choices > 1) {
-    print_error("give at most one of --address, --label and --continue");
-    return kExitUsageError;
-  }
+  if (choices > 1) return usage_error("give at most one of --address, --label and --continue");
   if (options.label.empty() != options.program.empty()) {
-    print_error("--label NAME needs --program FILE (the source that defines the label), and --program needs --label");
-    return kExitUsageError;
+    return usage_error(
+        "--label NAME needs --program FILE (the source that defines the label), and --program needs --label");
   }
   uint32_t address = options.address.value_or(0);
   if (!options.label.empty()) {
-    int exit_status = kExitSuccess;
-    const std::optional<LoadedProgram> program = load_program(options.program, options.include_dirs, exit_status);
-    if (!program) return exit_status;
+    const Result<LoadedProgram> program = load_program(options.program, options.include_dirs);
+    if (!program) return usage_error(program.error());
+    if (program->has_errors()) return report_program_errors(*program, options.program);
     const std::optional<uint32_t> found = program->label_address(options.label);
-    if (!found) {
-      print_error(fmt::format("{} defines no label '{}'", options.program, options.label));
-      return kExitUsageError;
-    }
+    if (!found) return usage_error(fmt::format("{} defines no label '{}'", options.program, options.label));
     address = *found;
   }
   Result<tools::TmclClient> client = connect(options.connection);
-  if (!client) {
-    print_error(client.error());
-    return kExitUsageError;
-  }
+  if (!client) return usage_error(client.error());
   // 129 type 0 continues from the current program counter, type 1 starts at the value's address.
   const tmcl::Instruction request = options.resume ? tmcl::Instruction{cmd::kRunApplication, 0, 0, 0}
                                                    : tmcl::Instruction{cmd::kRunApplication, 1, 0, static_cast<int32_t>(address)};
-  if (!control(client.value(), options.connection, request, "starting the program (129)")) return kExitUsageError;
+  const Result<tools::TmclReply> started =
+      control(client.value(), options.connection, request, "starting the program (129)");
+  if (!started) return usage_error(started.error());
   if (options.resume) {
     std::cout << "program continues from its program counter\n";
   } else if (!options.label.empty()) {
@@ -95,11 +85,10 @@ int run_start(const StartOptions& options) {
 int run_simple(const ModuleConnection& connection, const tmcl::Instruction& request, const std::string& what,
                const std::string& done) {
   Result<tools::TmclClient> client = connect(connection);
-  if (!client) {
-    print_error(client.error());
-    return kExitUsageError;
+  if (!client) return usage_error(client.error());
+  if (const Result<tools::TmclReply> reply = control(client.value(), connection, request, what); !reply) {
+    return usage_error(reply.error());
   }
-  if (!control(client.value(), connection, request, what)) return kExitUsageError;
   std::cout << done << '\n';
   return kExitSuccess;
 }
@@ -116,23 +105,24 @@ std::string application_status_name(uint32_t mode) {
   }
 }
 
-int run_status(const ModuleConnection& connection) {
-  Result<tools::TmclClient> client = connect(connection);
-  if (!client) {
-    print_error(client.error());
-    return kExitUsageError;
-  }
-  // Command 135 (docs/tmcl-programs.md): type 0 = mode << 24 | wait flag << 16 | download
-  // pointer, 1 = the same with the PC, 2 the accumulator, 3 the X register, 4 (Motwin) stop
-  // reason << 16 | stop address.
-  int32_t values[5] = {};
-  for (uint8_t type = 0; type <= 4; ++type) {
-    const std::optional<tools::TmclReply> reply =
-        control(client.value(), connection, tmcl::Instruction{cmd::kGetApplicationStatus, type, 0, 0},
+// Command 135 (docs/tmcl-programs.md), types 0 to 4: 0 = mode << 24 | wait flag << 16 |
+// download pointer, 1 = the same with the PC, 2 the accumulator, 3 the X register, 4 (Motwin)
+// stop reason << 16 | stop address.
+using ApplicationStatus = std::array<int32_t, 5>;
+
+Result<ApplicationStatus> read_application_status(tools::TmclClient& client, const ModuleConnection& connection) {
+  ApplicationStatus values{};
+  for (uint8_t type = 0; type < values.size(); ++type) {
+    const Result<tools::TmclReply> reply =
+        control(client, connection, tmcl::Instruction{cmd::kGetApplicationStatus, type, 0, 0},
                 fmt::format("reading the application status (135 type {})", type));
-    if (!reply) return kExitUsageError;
+    if (!reply) return Error{reply.error()};
     values[type] = reply->value;
   }
+  return values;
+}
+
+void print_application_status(const ApplicationStatus& values) {
   const auto status = static_cast<uint32_t>(values[1]);
   const uint32_t mode = status >> 24;
   const bool waiting = ((status >> 16) & 0xFF) != 0;
@@ -152,6 +142,14 @@ int run_status(const ModuleConnection& connection) {
     std::cout << fmt::format("stop reason:        {} ({}) at address {}\n", tmcl::stop_reason_text(reason),
                              static_cast<unsigned>(reason), stop_address);
   }
+}
+
+int run_status(const ModuleConnection& connection) {
+  Result<tools::TmclClient> client = connect(connection);
+  if (!client) return usage_error(client.error());
+  const Result<ApplicationStatus> status = read_application_status(client.value(), connection);
+  if (!status) return usage_error(status.error());
+  print_application_status(*status);
   return kExitSuccess;
 }
 

@@ -23,6 +23,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "cli/module_inputs.h"
 #include "cli/program_source.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/interpreter.h"
@@ -34,6 +35,7 @@
 #include "sim/scenario.h"
 #include "sim/signals.h"
 #include "tools/tmcl_mnemonics.h"
+#include "types/result.h"
 
 namespace motwin::cli {
 namespace {
@@ -62,11 +64,6 @@ struct RunOptions {
   bool until_stopped = false;
 };
 
-struct RunError {
-  std::string message;
-  int exit_status = kExitUsageError;
-};
-
 // "10s", "1ms", "250us", "2.5s", "1min"; a bare number is seconds.
 std::optional<uint64_t> parse_duration_us(std::string_view text) {
   struct Unit {
@@ -88,7 +85,7 @@ std::optional<uint64_t> parse_duration_us(std::string_view text) {
 }
 
 // "52,42" (and repeated options) -> numbers in 0..255.
-std::vector<uint8_t> parse_numbers(const std::vector<std::string>& lists, std::string_view option) {
+Result<std::vector<uint8_t>> parse_numbers(const std::vector<std::string>& lists, std::string_view option) {
   std::vector<uint8_t> numbers;
   for (const std::string& list : lists) {
     size_t begin = 0;
@@ -97,7 +94,7 @@ std::vector<uint8_t> parse_numbers(const std::vector<std::string>& lists, std::s
       const std::string word = list.substr(begin, comma - begin);
       const std::optional<int64_t> number = tools::parse_integer(word);
       if (!number || *number < 0 || *number > 255) {
-        throw RunError{fmt::format("{} {}: '{}' is not a parameter number 0..255", option, list, word)};
+        return Error{fmt::format("{} {}: '{}' is not a parameter number 0..255", option, list, word)};
       }
       numbers.push_back(static_cast<uint8_t>(*number));
       begin = comma + 1;
@@ -110,28 +107,175 @@ std::string format_seconds(uint64_t us) {
   return fmt::format("{}.{:06}", us / 1'000'000u, us % 1'000'000u);
 }
 
+// "status 5 (Invalid value)".
+std::string status_text(tmcl::Status status) {
+  return fmt::format("status {} ({})", tmcl::to_byte(status), tmcl::status_name(tmcl::to_byte(status)));
+}
+
+// --- Checking the options -------------------------------------------------------------------------
+
+// The options, checked: which module, how long, what to trace.
+struct RunPlan {
+  const host::ModuleDescriptor* descriptor = nullptr;
+  uint64_t duration_us = 0;
+  uint64_t sample_us = 0;
+  std::vector<uint8_t> params;     // axis parameters of --axis (--param; default: the module's)
+  std::vector<uint8_t> variables;  // user variables (--var)
+};
+
+Result<RunPlan> check_options(const RunOptions& options) {
+  RunPlan plan;
+  plan.descriptor = host::find_module(options.module);
+  if (plan.descriptor == nullptr) {
+    return Error{fmt::format("unknown module \"{}\" (available: {})", options.module, host::module_names())};
+  }
+  if (!plan.descriptor->endpoints.has_tmcl()) {
+    return Error{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", options.module,
+                             host::module_names(&host::has_tmcl))};
+  }
+  const std::optional<uint64_t> duration_us = parse_duration_us(options.duration);
+  if (!duration_us) {
+    return Error{fmt::format("--for {}: expected a duration such as 10s, 500ms or 2.5s", options.duration)};
+  }
+  plan.duration_us = *duration_us;
+  const std::optional<uint64_t> sample_us = parse_duration_us(options.sample);
+  if (!sample_us || *sample_us == 0) {
+    return Error{fmt::format("--sample {}: expected a duration such as 1ms, 50us or 0.1s", options.sample)};
+  }
+  plan.sample_us = *sample_us;
+  if (options.address && !options.label.empty()) return Error{"give at most one of --address and --label"};
+  Result<std::vector<uint8_t>> params = parse_numbers(options.params, "--param");
+  if (!params) return Error{params.error()};
+  // Default columns: the module's actual position and velocity.
+  plan.params = options.params.empty() ? plan.descriptor->trace_parameters : std::move(*params);
+  Result<std::vector<uint8_t>> variables = parse_numbers(options.variables, "--var");
+  if (!variables) return Error{variables.error()};
+  plan.variables = std::move(*variables);
+  return plan;
+}
+
+// --address, --label or 0.
+Result<uint32_t> start_address(const RunOptions& options, const LoadedProgram& program) {
+  if (options.label.empty()) return options.address.value_or(0);
+  const std::optional<uint32_t> found = program.label_address(options.label);
+  if (!found) return Error{fmt::format("{} defines no label '{}'", options.program, options.label)};
+  return *found;
+}
+
+// --- The module and the trace ---------------------------------------------------------------------
+
+// The module, as `motwin serve` makes it.
+Result<std::unique_ptr<host::VirtualModule>> make_module_to_run(const RunOptions& options,
+                                                                const host::ModuleDescriptor& descriptor,
+                                                                std::vector<host::InitialInput> initial_inputs) {
+  host::ModuleOptions module_options;
+  module_options.motor = options.motor_model;
+  module_options.initial_inputs = std::move(initial_inputs);
+  if (options.state_dir != host::kNoStateDir) module_options.state_dir = options.state_dir;
+  Result<std::unique_ptr<host::VirtualModule>> module = descriptor.make(module_options);
+  if (module && !(*module)->has_tmcl()) return Error{fmt::format("{} has no TMCL interpreter", (*module)->name())};
+  return module;
+}
+
+// The run in the module's control ticks.
+struct TickPlan {
+  uint64_t per_sample = 0;
+  uint64_t total = 0;
+};
+
+Result<TickPlan> ticks_of(const RunOptions& options, const RunPlan& plan, uint64_t tick_us) {
+  const uint64_t per_sample = plan.sample_us / tick_us;
+  if (per_sample == 0 || per_sample * tick_us != plan.sample_us) {
+    return Error{fmt::format("--sample {}: must be a whole number of the module's {} us control ticks", options.sample,
+                             tick_us)};
+  }
+  return TickPlan{per_sample, plan.duration_us / tick_us};
+}
+
 // One column of the trace: a direct-mode read through the engine.
 struct Column {
   std::string name;
   tmcl::Instruction read;
 };
 
-// Downloads through the engine, as a host would (docs/tmcl-programs.md).
-void download(tmcl::TmclEngine& engine, const std::vector<tmcl::Instruction>& program) {
-  const auto expect = [&](const tmcl::Instruction& in, tmcl::Status status, const std::string& what) {
-    const tmcl::CommandResult result = engine.execute(in, tmcl::Origin::kHost);
-    if (result.status != status) {
-      throw RunError{fmt::format("{}: the module answered status {} ({})", what, tmcl::to_byte(result.status),
-                                 tmcl::status_name(tmcl::to_byte(result.status)))};
-    }
-  };
-  expect({cmd::kEnterDownloadMode, 0, 0, 0}, tmcl::Status::kOk, "entering download mode (132)");
-  for (size_t i = 0; i < program.size(); ++i) {
-    expect(program[i], tmcl::Status::kStoredInProgram,
-           fmt::format("downloading address {} ({})", i, tools::format_instruction(program[i])));
+// "time_s,AP52,AP42,var0".
+std::string csv_header(const std::vector<Column>& columns) {
+  std::string header = "time_s";
+  for (const Column& column : columns) header += "," + column.name;
+  return header;
+}
+
+// The columns of the plan; each must be readable before the run starts.
+Result<std::vector<Column>> trace_columns(tmcl::TmclEngine& engine, std::string_view module_name, const RunPlan& plan,
+                                          int motor) {
+  std::vector<Column> columns;
+  for (const uint8_t number : plan.params) {
+    columns.push_back(
+        Column{fmt::format("AP{}", number), tmcl::Instruction{cmd::kGap, number, static_cast<uint8_t>(motor), 0}});
   }
-  expect({cmd::kNop, 0, 0, 0}, tmcl::Status::kStoredInProgram, "downloading the trailing NOP");
-  expect({cmd::kExitDownloadMode, 0, 0, 0}, tmcl::Status::kOk, "leaving download mode (133)");
+  for (const uint8_t number : plan.variables) {
+    columns.push_back(Column{fmt::format("var{}", number), tmcl::Instruction{cmd::kGgp, number, 2, 0}});
+  }
+  for (const Column& column : columns) {
+    const tmcl::CommandResult result = engine.execute(column.read, tmcl::Origin::kHost);
+    if (result.status != tmcl::Status::kOk) {
+      return Error{fmt::format("{} cannot be read on {} motor {}: {}", column.name, module_name, motor,
+                               status_text(result.status))};
+    }
+  }
+  return columns;
+}
+
+// Where the trace goes (--trace FILE, or - for stdout), and the report: stdout, or stderr when
+// stdout carries the trace.
+class TraceOutput {
+ public:
+  static Result<TraceOutput> open(const std::string& path) {
+    TraceOutput output;
+    output.to_stdout_ = path == "-";
+    if (!output.to_stdout_) {
+      output.file_.open(path, std::ios::trunc);
+      if (!output.file_) return Error{fmt::format("cannot write the trace to {}", path)};
+    }
+    return output;
+  }
+
+  std::ostream& trace() { return to_stdout_ ? std::cout : file_; }
+  std::ostream& report() { return to_stdout_ ? std::cerr : std::cout; }
+  bool to_stdout() const { return to_stdout_; }
+
+ private:
+  std::ofstream file_;
+  bool to_stdout_ = false;
+};
+
+// --- Running the program ----------------------------------------------------------------------------
+
+// Downloads through the engine, as a host would (docs/tmcl-programs.md).
+Result<void> download(tmcl::TmclEngine& engine, const std::vector<tmcl::Instruction>& program) {
+  // One request of the download, which the module must answer with `expected`.
+  const auto send = [&engine](const tmcl::Instruction& in, tmcl::Status expected,
+                              const std::string& what) -> Result<void> {
+    const tmcl::CommandResult result = engine.execute(in, tmcl::Origin::kHost);
+    if (result.status == expected) return {};
+    return Error{fmt::format("{}: the module answered {}", what, status_text(result.status))};
+  };
+  Result<void> sent = send({cmd::kEnterDownloadMode, 0, 0, 0}, tmcl::Status::kOk, "entering download mode (132)");
+  for (size_t i = 0; sent && i < program.size(); ++i) {
+    sent = send(program[i], tmcl::Status::kStoredInProgram,
+                fmt::format("downloading address {} ({})", i, tools::format_instruction(program[i])));
+  }
+  if (sent) sent = send({cmd::kNop, 0, 0, 0}, tmcl::Status::kStoredInProgram, "downloading the trailing NOP");
+  if (sent) sent = send({cmd::kExitDownloadMode, 0, 0, 0}, tmcl::Status::kOk, "leaving download mode (133)");
+  return sent;
+}
+
+// 129 type 1: the program runs from `address`.
+Result<void> start_program(tmcl::TmclEngine& engine, uint32_t address) {
+  const tmcl::CommandResult started =
+      engine.execute(tmcl::Instruction{cmd::kRunApplication, 1, 0, static_cast<int32_t>(address)}, tmcl::Origin::kHost);
+  if (started.status == tmcl::Status::kOk) return {};
+  return Error{fmt::format("starting at address {} (129): {}", address, status_text(started.status))};
 }
 
 bool is_fault(tmcl::StopReason reason) {
@@ -149,111 +293,21 @@ bool is_fault(tmcl::StopReason reason) {
   return false;
 }
 
-int run_run(const RunOptions& options) {
-  const host::ModuleDescriptor* descriptor = host::find_module(options.module);
-  if (descriptor == nullptr) {
-    throw RunError{fmt::format("unknown module \"{}\" (available: {})", options.module, host::module_names())};
-  }
-  if (!descriptor->endpoints.has_tmcl()) {
-    throw RunError{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", options.module,
-                               host::module_names(&host::has_tmcl))};
-  }
-  const std::optional<uint64_t> duration_us = parse_duration_us(options.duration);
-  if (!duration_us) throw RunError{fmt::format("--for {}: expected a duration such as 10s, 500ms or 2.5s", options.duration)};
-  const std::optional<uint64_t> sample_us = parse_duration_us(options.sample);
-  if (!sample_us || *sample_us == 0) {
-    throw RunError{fmt::format("--sample {}: expected a duration such as 1ms, 50us or 0.1s", options.sample)};
-  }
-  if (options.address && !options.label.empty()) throw RunError{"give at most one of --address and --label"};
-  // Default columns: the module's actual position and velocity.
-  const std::vector<uint8_t> params =
-      options.params.empty() ? descriptor->trace_parameters : parse_numbers(options.params, "--param");
-  const std::vector<uint8_t> variables = parse_numbers(options.variables, "--var");
+// What the sample loop saw.
+struct RunSummary {
+  uint64_t samples = 0;
+  std::optional<uint64_t> stopped_at_us;  // the first sample that saw the program stopped
+  uint64_t simulated_us = 0;
+  uint64_t instructions = 0;
+  double wall_s = 0;
+};
 
-  int exit_status = kExitSuccess;
-  const std::optional<LoadedProgram> program = load_program(options.program, options.include_dirs, exit_status);
-  if (!program) return exit_status;
-  uint32_t start_address = options.address.value_or(0);
-  if (!options.label.empty()) {
-    const std::optional<uint32_t> found = program->label_address(options.label);
-    if (!found) throw RunError{fmt::format("{} defines no label '{}'", options.program, options.label)};
-    start_address = *found;
-  }
-
-  // The module, as `motwin serve` makes it.
-  host::ModuleOptions module_options;
-  module_options.motor = options.motor_model;
-  for (const std::string& text : options.assignments) {
-    const Result<sim::SignalAssignment> assignment = sim::parse_signal_assignment(descriptor->input_signals(), text);
-    if (!assignment) throw RunError{"--set " + text + ": " + assignment.error()};
-    module_options.initial_inputs.push_back(host::InitialInput{std::string(assignment->signal->name), assignment->value});
-  }
-  std::optional<std::vector<sim::ScenarioEvent>> scenario;
-  if (!options.scenario_path.empty()) {
-    Result<std::vector<sim::ScenarioEvent>> events =
-        sim::load_scenario_file(options.scenario_path, descriptor->input_signals());
-    if (!events) throw RunError{events.error()};
-    scenario = std::move(*events);
-  }
-  if (options.state_dir != host::kNoStateDir) module_options.state_dir = options.state_dir;
-  host::MakeModuleResult made = descriptor->make(module_options);
-  if (!made) throw RunError{made.error()};
-  host::VirtualModule& module = **made;
-  if (!module.has_tmcl()) throw RunError{fmt::format("{} has no TMCL interpreter", module.name())};
-  const uint64_t tick_us = module.tick_period_us();
-  const uint64_t sample_ticks = *sample_us / tick_us;
-  if (sample_ticks == 0 || sample_ticks * tick_us != *sample_us) {
-    throw RunError{fmt::format("--sample {}: must be a whole number of the module's {} us control ticks", options.sample,
-                               tick_us)};
-  }
-  const uint64_t total_ticks = *duration_us / tick_us;
-
-  tmcl::TmclEngine& engine = module.engine();
-  std::vector<Column> columns;
-  for (const uint8_t number : params) {
-    columns.push_back(Column{fmt::format("AP{}", number),
-                             tmcl::Instruction{cmd::kGap, number, static_cast<uint8_t>(options.motor), 0}});
-  }
-  for (const uint8_t number : variables) {
-    columns.push_back(Column{fmt::format("var{}", number), tmcl::Instruction{cmd::kGgp, number, 2, 0}});
-  }
-  // Every column must be readable before the run starts.
-  for (const Column& column : columns) {
-    const tmcl::CommandResult result = engine.execute(column.read, tmcl::Origin::kHost);
-    if (result.status != tmcl::Status::kOk) {
-      throw RunError{fmt::format("{} cannot be read on {} motor {}: status {} ({})", column.name, module.name(),
-                                 options.motor, tmcl::to_byte(result.status),
-                                 tmcl::status_name(tmcl::to_byte(result.status)))};
-    }
-  }
-
-  std::ofstream file;
-  const bool to_stdout = options.trace == "-";
-  if (!to_stdout) {
-    file.open(options.trace, std::ios::trunc);
-    if (!file) throw RunError{fmt::format("cannot write the trace to {}", options.trace)};
-  }
-  std::ostream& trace = to_stdout ? std::cout : file;
-  std::ostream& report = to_stdout ? std::cerr : std::cout;
-
-  download(engine, program->instructions);
-  host::HostRuntime runtime(module, host::Pacing::fast());
-  if (scenario) runtime.set_scenario(std::move(*scenario));
-  runtime.set_output_listener([&report](const sim::OutputChange& change) {
-    report << "output " << change.signal << ' ' << change.level << " at " << format_seconds(change.sim_time_us) << '\n';
-  });
-  runtime.start();
-  const tmcl::CommandResult started =
-      engine.execute(tmcl::Instruction{cmd::kRunApplication, 1, 0, static_cast<int32_t>(start_address)}, tmcl::Origin::kHost);
-  if (started.status != tmcl::Status::kOk) {
-    throw RunError{fmt::format("starting at address {} (129): status {} ({})", start_address,
-                               tmcl::to_byte(started.status), tmcl::status_name(tmcl::to_byte(started.status)))};
-  }
-
+// Runs the ticks back to back and writes a row at the start, after every `ticks.per_sample`
+// and at the end; with `until_stopped` the run ends at the first row after the program stopped.
+RunSummary sample_loop(host::HostRuntime& runtime, tmcl::TmclEngine& engine, const std::vector<Column>& columns,
+                       TickPlan ticks, bool until_stopped, std::ostream& trace) {
   const uint64_t start_us = runtime.sim_time_us();
-  trace << "time_s";
-  for (const Column& column : columns) trace << ',' << column.name;
-  trace << '\n';
+  trace << csv_header(columns) << '\n';
   std::string row;
   const auto sample = [&] {
     row = format_seconds(runtime.sim_time_us() - start_us);
@@ -270,44 +324,87 @@ int run_run(const RunOptions& options) {
 
   const auto wall_start = std::chrono::steady_clock::now();
   const uint64_t instructions_before = engine.interpreter().instructions_executed();
-  uint64_t samples = 0;
-  std::optional<uint64_t> stopped_at_us;
+  RunSummary summary;
   sample();
-  ++samples;
+  ++summary.samples;
   uint64_t ticks_done = 0;
-  while (ticks_done < total_ticks) {
-    const uint64_t batch = std::min(sample_ticks, total_ticks - ticks_done);
+  while (ticks_done < ticks.total) {
+    const uint64_t batch = std::min(ticks.per_sample, ticks.total - ticks_done);
     runtime.advance_ticks(batch);
     ticks_done += batch;
     sample();
-    ++samples;
-    if (!stopped_at_us && !running()) {
-      stopped_at_us = runtime.sim_time_us() - start_us;
-      if (options.until_stopped) break;
+    ++summary.samples;
+    if (!summary.stopped_at_us && !running()) {
+      summary.stopped_at_us = runtime.sim_time_us() - start_us;
+      if (until_stopped) break;
     }
   }
   trace.flush();
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  const uint64_t simulated_us = runtime.sim_time_us() - start_us;
-  const uint64_t instructions = engine.interpreter().instructions_executed() - instructions_before;
+  summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  summary.simulated_us = runtime.sim_time_us() - start_us;
+  summary.instructions = engine.interpreter().instructions_executed() - instructions_before;
+  return summary;
+}
 
+// The report after the run; the exit status says whether the program stopped on a fault.
+int report_run(const RunOptions& options, std::string_view module_name, tmcl::TmclEngine& engine,
+               const std::vector<Column>& columns, const RunSummary& summary, TraceOutput& output) {
+  std::ostream& report = output.report();
   report << fmt::format("{}: {} s of simulated time on {} in {:.3f} s ({:.1f}x real time), {} instructions\n",
-                        options.program, format_seconds(simulated_us), module.name(), wall_s,
-                        wall_s > 0 ? static_cast<double>(simulated_us) * 1e-6 / wall_s : 0.0, instructions);
-  std::string header = "time_s";
-  for (const Column& column : columns) header += "," + column.name;
-  report << fmt::format("trace: {} samples ({}) every {} to {}\n", samples, header, options.sample,
-                        to_stdout ? "stdout" : options.trace);
+                        options.program, format_seconds(summary.simulated_us), module_name, summary.wall_s,
+                        summary.wall_s > 0 ? static_cast<double>(summary.simulated_us) * 1e-6 / summary.wall_s : 0.0,
+                        summary.instructions);
+  report << fmt::format("trace: {} samples ({}) every {} to {}\n", summary.samples, csv_header(columns), options.sample,
+                        output.to_stdout() ? "stdout" : options.trace);
   const tmcl::StopReason reason = engine.interpreter().stop_reason();
-  if (!stopped_at_us) {
+  if (!summary.stopped_at_us) {
     report << fmt::format("program: still running at the end (program counter {})\n",
                           engine.device().runtime().program_counter);
     return kExitSuccess;
   }
   report << fmt::format("program: stopped by t={} s (seen at the first sample after): {} at address {}\n",
-                        format_seconds(*stopped_at_us), tmcl::stop_reason_text(reason),
+                        format_seconds(*summary.stopped_at_us), tmcl::stop_reason_text(reason),
                         engine.interpreter().stop_address());
   return is_fault(reason) ? kExitProgramFault : kExitSuccess;
+}
+
+int run_run(const RunOptions& options) {
+  const Result<RunPlan> plan = check_options(options);
+  if (!plan) return usage_error(plan.error());
+  const Result<LoadedProgram> program = load_program(options.program, options.include_dirs);
+  if (!program) return usage_error(program.error());
+  if (program->has_errors()) return report_program_errors(*program, options.program);
+  const Result<uint32_t> address = start_address(options, *program);
+  if (!address) return usage_error(address.error());
+
+  Result<ModuleInputs> inputs =
+      read_module_inputs(plan->descriptor->input_signals(), options.assignments, options.scenario_path);
+  if (!inputs) return usage_error(inputs.error());
+  const Result<std::unique_ptr<host::VirtualModule>> made =
+      make_module_to_run(options, *plan->descriptor, std::move(inputs->initial_inputs));
+  if (!made) return usage_error(made.error());
+  host::VirtualModule& module = **made;
+  const Result<TickPlan> ticks = ticks_of(options, *plan, module.tick_period_us());
+  if (!ticks) return usage_error(ticks.error());
+  tmcl::TmclEngine& engine = module.engine();
+  const Result<std::vector<Column>> columns = trace_columns(engine, module.name(), *plan, options.motor);
+  if (!columns) return usage_error(columns.error());
+  Result<TraceOutput> output = TraceOutput::open(options.trace);
+  if (!output) return usage_error(output.error());
+
+  if (const Result<void> downloaded = download(engine, program->instructions); !downloaded) {
+    return usage_error(downloaded.error());
+  }
+  host::HostRuntime runtime(module, host::Pacing::fast());
+  if (inputs->scenario) runtime.set_scenario(std::move(*inputs->scenario));
+  std::ostream& report = output->report();
+  runtime.set_output_listener([&report](const sim::OutputChange& change) {
+    report << "output " << change.signal << ' ' << change.level << " at " << format_seconds(change.sim_time_us) << '\n';
+  });
+  runtime.start();
+  if (const Result<void> started = start_program(engine, *address); !started) return usage_error(started.error());
+  const RunSummary summary = sample_loop(runtime, engine, *columns, *ticks, options.until_stopped, output->trace());
+  return report_run(options, module.name(), engine, *columns, summary, *output);
 }
 
 }  // namespace
@@ -375,14 +472,7 @@ void add_run_command(CLI::App& app, int& exit_status) {
       "keeps being sampled until --for (motion continues), unless --until-stopped.\n"
       "Exit status: 0 done, 1 the program has errors or stopped on a fault (jump outside memory,\n"
       "invalid instruction ...), 2 usage error or unreadable file. See docs/tmcl-programs.md.\n");
-  command->callback([options, &exit_status] {
-    try {
-      exit_status = run_run(*options);
-    } catch (const RunError& error) {
-      print_error(error.message);
-      exit_status = error.exit_status;
-    }
-  });
+  command->callback([options, &exit_status] { exit_status = run_run(*options); });
 }
 
 }  // namespace motwin::cli
