@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <fmt/format.h>
@@ -13,6 +14,7 @@
 #include "cli/commands.h"
 #include "tools/tmcl_assembler.h"
 #include "tools/tmcl_binary.h"
+#include "types/result.h"
 
 namespace motwin::cli {
 namespace {
@@ -28,16 +30,20 @@ struct AsmOptions {
   size_t program_memory = tools::kDefaultProgramMemorySize;
 };
 
-// "-" writes to stdout.
-bool write_text(const std::string& path, const std::string& text) {
+// Writes the `what` (the listing, the symbols) to `path`; "-" writes to stdout.
+Result<void> write_text(const std::string& path, const std::string& text, std::string_view what) {
+  bool written = false;
   if (path == "-") {
     std::cout << text << std::flush;
-    return static_cast<bool>(std::cout);
+    written = static_cast<bool>(std::cout);
+  } else {
+    std::ofstream out(path, std::ios::trunc);
+    out << text;
+    out.close();
+    written = static_cast<bool>(out);
   }
-  std::ofstream out(path, std::ios::trunc);
-  out << text;
-  out.close();
-  return static_cast<bool>(out);
+  if (written) return {};
+  return Error{fmt::format("cannot write the {} to {}", what, path)};
 }
 
 int run_asm(const AsmOptions& options) {
@@ -57,21 +63,17 @@ int run_asm(const AsmOptions& options) {
                                  ? std::filesystem::path(options.source).replace_extension(".bin").string()
                                  : options.output;
   if (std::filesystem::path(output).lexically_normal() == std::filesystem::path(options.source).lexically_normal()) {
-    print_error(fmt::format("the output {} would overwrite the source; give another name with -o", output));
-    return kExitUsageError;
+    return usage_error(fmt::format("the output {} would overwrite the source; give another name with -o", output));
   }
   const Result<size_t> written = tools::write_program_binary(output, result.instructions);
-  if (!written) {
-    print_error(written.error());
-    return kExitUsageError;
+  if (!written) return usage_error(written.error());
+  if (!options.listing.empty()) {
+    const Result<void> listed = write_text(options.listing, tools::format_listing(result), "listing");
+    if (!listed) return usage_error(listed.error());
   }
-  if (!options.listing.empty() && !write_text(options.listing, tools::format_listing(result))) {
-    print_error(fmt::format("cannot write the listing to {}", options.listing));
-    return kExitUsageError;
-  }
-  if (!options.symbols.empty() && !write_text(options.symbols, tools::format_symbols(result))) {
-    print_error(fmt::format("cannot write the symbols to {}", options.symbols));
-    return kExitUsageError;
+  if (!options.symbols.empty()) {
+    const Result<void> symbols = write_text(options.symbols, tools::format_symbols(result), "symbols");
+    if (!symbols) return usage_error(symbols.error());
   }
   // The summary goes to stderr when stdout carries the listing or the symbols.
   const bool stdout_taken = options.listing == "-" || options.symbols == "-";

@@ -7,11 +7,13 @@
 //            then `lss store` works as a sequence of commands. Exit status 0; 1 when a slave
 //            refused (its error code on stderr) or fastscan found nobody.
 // Both: 2 for bad arguments, no connection or no answer.
+#include <charconv>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "cli/bus_connection.h"
 #include "cli/cli_errors.h"
@@ -22,17 +24,17 @@
 namespace motwin::cli {
 namespace {
 
-std::optional<uint32_t> parse_number(const std::string& text) {
-  if (text.empty()) return std::nullopt;
+// Decimal or 0x hexadecimal, 32 bits.
+std::optional<uint32_t> parse_number(std::string_view text) {
   const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
-  const std::string digits = hex ? text.substr(2) : text;
-  if (digits.empty() || digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos ||
-      digits.size() > (hex ? 8u : 10u)) {
+  const std::string_view digits = hex ? text.substr(2) : text;
+  uint32_t value = 0;
+  const auto [end, problem] = std::from_chars(digits.data(), digits.data() + digits.size(), value, hex ? 16 : 10);
+  if (digits.empty() || digits.size() > (hex ? 8u : 10u) || problem != std::errc{} ||
+      end != digits.data() + digits.size()) {
     return std::nullopt;
   }
-  const unsigned long long value = std::stoull(digits, nullptr, hex ? 16 : 10);
-  if (value > 0xFFFFFFFFull) return std::nullopt;
-  return static_cast<uint32_t>(value);
+  return value;
 }
 
 std::string hex32(uint32_t value) {
@@ -64,22 +66,45 @@ struct LssOptions {
 // Runs `body` on a connected master; sets exit_status.
 template <typename Body>
 void with_master(const LssOptions& options, int& exit_status, Body body) {
-  std::unique_ptr<tools::SocketcandClient> bus = connect_can(options.can, exit_status);
-  if (!bus) return;
-  tools::LssMaster master(*bus, static_cast<int>(options.timeout_s * 1000));
+  const Result<std::unique_ptr<tools::SocketcandClient>> bus = connect_can(options.can);
+  if (!bus) {
+    exit_status = usage_error(bus.error());
+    return;
+  }
+  tools::LssMaster master(**bus, static_cast<int>(options.timeout_s * 1000));
   exit_status = body(master);
+}
+
+struct CandumpOptions {
+  std::string can = kDefaultCanEndpoint;
+  int count = 0;
+  double timeout_s = 0;
+  std::string channel = "can0";
+};
+
+// Prints frames until --count of them, the end of the connection or --timeout; the exit status.
+int dump_frames(tools::SocketcandClient& bus, const CandumpOptions& options) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  int received = 0;
+  // Without a timeout, wait in slices so that a closed connection is noticed.
+  const int slice_ms = options.timeout_s > 0 ? static_cast<int>(options.timeout_s * 1000) : 1000;
+  while (options.count == 0 || received < options.count) {
+    const std::optional<tools::ReceivedFrame> frame = bus.receive_stamped(slice_ms);
+    if (!frame) {
+      if (!bus.connected()) break;
+      if (options.timeout_s > 0) return options.count == 0 ? kExitSuccess : kExitModuleError;
+      continue;
+    }
+    std::cout << host::format_candump_line(frame->frame, frame->timestamp_us, options.channel) << '\n' << std::flush;
+    ++received;
+  }
+  return kExitSuccess;
 }
 
 }  // namespace
 
 void add_candump_command(CLI::App& app, int& exit_status) {
-  struct Options {
-    std::string can = kDefaultCanEndpoint;
-    int count = 0;
-    double timeout_s = 0;
-    std::string channel = "can0";
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<CandumpOptions>();
   CLI::App* candump = app.add_subcommand("candump", "Print the frames of a CAN bus as candump -L log lines");
   candump->add_option("--can", options->can, "Bus endpoint")->type_name("socketcand:HOST:PORT")->capture_default_str();
   candump->add_option("--count", options->count, "Stop after N frames (0: no limit)")->type_name("N")->check(CLI::NonNegativeNumber);
@@ -92,26 +117,8 @@ void add_candump_command(CLI::App& app, int& exit_status) {
       "readable by canplayer and python-can. Exit status 0 when --count frames arrived or the connection ended, "
       "1 when --timeout passed before --count frames, 2 when the endpoint cannot be reached.");
   candump->callback([options, &exit_status] {
-    std::unique_ptr<tools::SocketcandClient> bus = connect_can(options->can, exit_status);
-    if (!bus) return;
-    std::setvbuf(stdout, nullptr, _IOLBF, 0);
-    int received = 0;
-    // Without a timeout, wait in slices so that a closed connection is noticed.
-    const int slice_ms = options->timeout_s > 0 ? static_cast<int>(options->timeout_s * 1000) : 1000;
-    while (options->count == 0 || received < options->count) {
-      const std::optional<tools::ReceivedFrame> frame = bus->receive_stamped(slice_ms);
-      if (!frame) {
-        if (!bus->connected()) break;
-        if (options->timeout_s > 0) {
-          exit_status = options->count == 0 ? kExitSuccess : kExitModuleError;
-          return;
-        }
-        continue;
-      }
-      std::cout << host::format_candump_line(frame->frame, frame->timestamp_us, options->channel) << '\n' << std::flush;
-      ++received;
-    }
-    exit_status = kExitSuccess;
+    const Result<std::unique_ptr<tools::SocketcandClient>> bus = connect_can(options->can);
+    exit_status = bus ? dump_frames(**bus, *options) : usage_error(bus.error());
   });
 }
 
@@ -140,8 +147,7 @@ void add_lss_command(CLI::App& app, int& exit_status) {
     std::optional<uint32_t> parts[4];
     for (size_t i = 0; i < 4; ++i) parts[i] = parse_number(options->identity[i]);
     if (!parts[0] || !parts[1] || !parts[2] || !parts[3]) {
-      print_error("expected VENDOR PRODUCT REVISION SERIAL as numbers");
-      exit_status = kExitUsageError;
+      exit_status = usage_error("expected VENDOR PRODUCT REVISION SERIAL as numbers");
       return;
     }
     with_master(*options, exit_status, [&](tools::LssMaster& master) {
@@ -164,8 +170,8 @@ void add_lss_command(CLI::App& app, int& exit_status) {
   bit_rate->callback([options, &exit_status] {
     const std::optional<uint8_t> index = tools::LssMaster::bit_timing_index(options->bit_rate_kbit);
     if (!index) {
-      print_error("bit rate " + std::to_string(options->bit_rate_kbit) + " kbit/s is not in CiA-305 table 0");
-      exit_status = kExitUsageError;
+      exit_status =
+          usage_error("bit rate " + std::to_string(options->bit_rate_kbit) + " kbit/s is not in CiA-305 table 0");
       return;
     }
     with_master(*options, exit_status, [&](tools::LssMaster& master) { return report(master.configure_bit_timing(*index)); });

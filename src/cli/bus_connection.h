@@ -5,30 +5,22 @@
 #include <memory>
 #include <string>
 
-#include "cli/cli_errors.h"
 #include "host/can_endpoint.h"
 #include "tools/canopen_client.h"
+#include "types/result.h"
 
 namespace motwin::cli {
 
 inline constexpr const char* kDefaultCanEndpoint = "socketcand:127.0.0.1:29536";
 
-// Connects and enters raw mode; nullptr after printing the error (exit_status = 2).
-inline std::unique_ptr<tools::SocketcandClient> connect_can(const std::string& endpoint, int& exit_status) {
+// Connects and enters raw mode.
+inline Result<std::unique_ptr<tools::SocketcandClient>> connect_can(const std::string& endpoint) {
   const Result<host::CanEndpointSpec> spec = host::parse_can_endpoint(endpoint);
-  if (!spec || spec->transport != host::CanTransport::kSocketcand) {
-    print_error("--can: " + (spec ? std::string("only socketcand endpoints are supported here") : spec.error()));
-    exit_status = kExitUsageError;
-    return nullptr;
+  if (!spec) return spec.error_with_context("--can: ");
+  if (spec->transport != host::CanTransport::kSocketcand) {
+    return Error{"--can: only socketcand endpoints are supported here"};
   }
-  Result<std::unique_ptr<tools::SocketcandClient>> opened =
-      tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
-  if (!opened) {
-    print_error(opened.error());
-    exit_status = kExitUsageError;
-    return nullptr;
-  }
-  return std::move(*opened);
+  return tools::SocketcandClient::connect(spec->tcp.host, spec->tcp.port);
 }
 
 }  // namespace motwin::cli

@@ -25,10 +25,6 @@ struct Target {
   int node = 1;
 };
 
-std::unique_ptr<tools::SocketcandClient> connect(const Target& target, int& exit_status) {
-  return connect_can(target.can, exit_status);
-}
-
 std::optional<uint32_t> parse_unsigned(const std::string& text, int base) {
   if (text.empty()) return std::nullopt;
   char* end = nullptr;
@@ -75,6 +71,31 @@ std::string format_value(const std::vector<uint8_t>& data, const std::string& ty
   return std::to_string(raw);
 }
 
+// VALUE as TYPE puts it on the bus: little-endian numbers, the text of str, the bytes of hex
+// (two hex digits each); nullopt when it does not fit the type.
+std::optional<std::vector<uint8_t>> encode_value(const std::string& type, const std::string& value) {
+  const int size = type_size(type);
+  if (size < 0) return std::nullopt;
+  if (type == "str") return std::vector<uint8_t>(value.begin(), value.end());
+  std::vector<uint8_t> data;
+  if (type == "hex") {
+    if (value.empty() || value.size() % 2 != 0) return std::nullopt;
+    for (size_t i = 0; i < value.size(); i += 2) {
+      const std::optional<uint32_t> byte = parse_unsigned(value.substr(i, 2), 16);
+      if (!byte) return std::nullopt;
+      data.push_back(static_cast<uint8_t>(*byte));
+    }
+    return data;
+  }
+  const bool negative = !value.empty() && value[0] == '-';
+  const std::optional<uint32_t> magnitude = parse_unsigned(negative ? value.substr(1) : value, 10);
+  if (!magnitude || (negative && type[0] != 'i')) return std::nullopt;
+  const uint32_t raw = negative ? static_cast<uint32_t>(-static_cast<int64_t>(*magnitude)) : *magnitude;
+  for (int i = 0; i < size; ++i) data.push_back(static_cast<uint8_t>(raw >> (8 * i)));
+  return data;
+}
+
+// The node's answer: the exit status, and the abort or the failure on stderr.
 int report(const tools::SdoResult& result) {
   if (result.ok) return kExitSuccess;
   if (result.abort_code != 0) {
@@ -109,13 +130,15 @@ void add_canopen_commands(CLI::App& app, int& exit_status) {
     const std::optional<uint32_t> index = parse_unsigned(read->index, 16);
     const std::optional<uint32_t> sub = parse_unsigned(read->sub, 10);
     if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || (!read->type.empty() && type_size(read->type) < 0)) {
-      print_error("expected NODE INDEX SUB [u8|u16|u32|i8|i16|i32|str|hex]");
-      exit_status = kExitUsageError;
+      exit_status = usage_error("expected NODE INDEX SUB [u8|u16|u32|i8|i16|i32|str|hex]");
       return;
     }
-    std::unique_ptr<tools::SocketcandClient> bus = connect(read->target, exit_status);
-    if (!bus) return;
-    const tools::SdoResult result = tools::sdo_upload(*bus, static_cast<uint8_t>(read->target.node),
+    const Result<std::unique_ptr<tools::SocketcandClient>> bus = connect_can(read->target.can);
+    if (!bus) {
+      exit_status = usage_error(bus.error());
+      return;
+    }
+    const tools::SdoResult result = tools::sdo_upload(**bus, static_cast<uint8_t>(read->target.node),
                                                       static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub));
     exit_status = report(result);
     if (result.ok) std::cout << format_value(result.data, read->type) << '\n';
@@ -136,35 +159,18 @@ void add_canopen_commands(CLI::App& app, int& exit_status) {
   write_cmd->callback([write, &exit_status] {
     const std::optional<uint32_t> index = parse_unsigned(write->index, 16);
     const std::optional<uint32_t> sub = parse_unsigned(write->sub, 10);
-    const int size = type_size(write->type);
-    std::vector<uint8_t> data;
-    bool ok = index && *index <= 0xFFFF && sub && *sub <= 0xFF && size >= 0;
-    if (ok && write->type == "str") {
-      data.assign(write->value.begin(), write->value.end());
-    } else if (ok && write->type == "hex") {
-      ok = write->value.size() % 2 == 0 && !write->value.empty();
-      for (size_t i = 0; ok && i < write->value.size(); i += 2) {
-        const std::optional<uint32_t> byte = parse_unsigned(write->value.substr(i, 2), 16);
-        ok = byte.has_value();
-        if (ok) data.push_back(static_cast<uint8_t>(*byte));
-      }
-    } else if (ok) {
-      const std::string& text = write->value;
-      const bool negative = !text.empty() && text[0] == '-';
-      const std::optional<uint32_t> magnitude = parse_unsigned(negative ? text.substr(1) : text, 10);
-      ok = magnitude.has_value() && (!negative || write->type[0] == 'i');
-      const uint32_t raw = ok ? (negative ? static_cast<uint32_t>(-static_cast<int64_t>(*magnitude)) : *magnitude) : 0;
-      for (int i = 0; ok && i < size; ++i) data.push_back(static_cast<uint8_t>(raw >> (8 * i)));
-    }
-    if (!ok) {
-      print_error("expected NODE INDEX SUB TYPE VALUE with TYPE u8|u16|u32|i8|i16|i32|str|hex");
-      exit_status = kExitUsageError;
+    const std::optional<std::vector<uint8_t>> data = encode_value(write->type, write->value);
+    if (!index || *index > 0xFFFF || !sub || *sub > 0xFF || !data) {
+      exit_status = usage_error("expected NODE INDEX SUB TYPE VALUE with TYPE u8|u16|u32|i8|i16|i32|str|hex");
       return;
     }
-    std::unique_ptr<tools::SocketcandClient> bus = connect(write->target, exit_status);
-    if (!bus) return;
-    exit_status = report(tools::sdo_download(*bus, static_cast<uint8_t>(write->target.node),
-                                             static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), data));
+    const Result<std::unique_ptr<tools::SocketcandClient>> bus = connect_can(write->target.can);
+    if (!bus) {
+      exit_status = usage_error(bus.error());
+      return;
+    }
+    exit_status = report(tools::sdo_download(**bus, static_cast<uint8_t>(write->target.node),
+                                             static_cast<uint16_t>(*index), static_cast<uint8_t>(*sub), *data));
   });
 
   struct NmtOptions {
@@ -184,15 +190,14 @@ void add_canopen_commands(CLI::App& app, int& exit_status) {
                          : nmt->command == "preop" ? 0x80
                          : nmt->command == "reset" ? 0x81
                                                    : 0x82;
-    std::unique_ptr<tools::SocketcandClient> bus = connect(nmt->target, exit_status);
-    if (!bus) return;
-    const uint8_t data[2] = {code, static_cast<uint8_t>(nmt->target.node)};
-    if (!bus->send(can::make_frame(0x000, data, 2))) {
-      print_error("cannot send to the socketcand server");
-      exit_status = kExitUsageError;
+    const Result<std::unique_ptr<tools::SocketcandClient>> bus = connect_can(nmt->target.can);
+    if (!bus) {
+      exit_status = usage_error(bus.error());
       return;
     }
-    exit_status = kExitSuccess;
+    const uint8_t data[2] = {code, static_cast<uint8_t>(nmt->target.node)};
+    exit_status = (*bus)->send(can::make_frame(0x000, data, 2)) ? kExitSuccess
+                                                                : usage_error("cannot send to the socketcand server");
   });
 }
 

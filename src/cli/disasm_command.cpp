@@ -12,6 +12,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "cli/module_connection.h"
 #include "tools/program_transfer.h"
 #include "tools/tmcl_assembler.h"
 #include "tools/tmcl_binary.h"
@@ -23,10 +24,7 @@ namespace {
 
 struct DisasmOptions {
   std::string binary;
-  std::string tcp_address;
-  std::string serial_device;
-  int module_address = tools::kDefaultModuleAddress;
-  int timeout_ms = static_cast<int>(tools::kDefaultReplyTimeout.count());
+  ModuleConnection connection;
   uint32_t start = 0;
   std::optional<uint32_t> count;
   uint32_t program_memory = static_cast<uint32_t>(tools::kDefaultProgramMemorySize);
@@ -35,35 +33,24 @@ struct DisasmOptions {
 };
 
 Result<std::vector<tmcl::Instruction>> read_from_module(const DisasmOptions& options) {
-  Result<tools::TmclClient> client =
-      options.tcp_address.empty()
-          ? tools::TmclClient::open_serial(options.serial_device)
-          : tools::TmclClient::connect_tcp(options.tcp_address, std::chrono::milliseconds(options.timeout_ms));
+  Result<tools::TmclClient> client = connect(options.connection);
   if (!client) return Error{client.error()};
-  client->set_reply_timeout(std::chrono::milliseconds(options.timeout_ms));
-  const auto module_address = static_cast<uint8_t>(options.module_address);
+  const uint8_t module_address = options.connection.address();
   if (options.count) return tools::read_program(client.value(), options.start, *options.count, module_address);
   const uint32_t remaining = options.program_memory - std::min(options.start, options.program_memory);
   return tools::read_stored_program(client.value(), options.start, remaining, module_address);
 }
 
 int run_disasm(const DisasmOptions& options) {
-  const int sources = (options.binary.empty() ? 0 : 1) + (options.tcp_address.empty() ? 0 : 1) +
-                      (options.serial_device.empty() ? 0 : 1);
-  if (sources != 1) {
-    print_error("give exactly one of PROGRAM.bin, --tcp HOST:PORT or --serial DEVICE");
-    return kExitUsageError;
-  }
+  const int sources = (options.binary.empty() ? 0 : 1) + (options.connection.tcp_address.empty() ? 0 : 1) +
+                      (options.connection.serial_device.empty() ? 0 : 1);
+  if (sources != 1) return usage_error("give exactly one of PROGRAM.bin, --tcp HOST:PORT or --serial DEVICE");
   if (!options.binary.empty() && (options.count || options.start != 0)) {
-    print_error("--start and --count apply to reading a module's memory (--tcp or --serial)");
-    return kExitUsageError;
+    return usage_error("--start and --count apply to reading a module's memory (--tcp or --serial)");
   }
   const Result<std::vector<tmcl::Instruction>> program =
       options.binary.empty() ? read_from_module(options) : tools::read_program_binary(options.binary);
-  if (!program) {
-    print_error(program.error());
-    return kExitUsageError;
-  }
+  if (!program) return usage_error(program.error());
   tools::DisassemblyOptions disassembly;
   disassembly.address_comments = !options.no_addresses;
   disassembly.omit_final_stop = !options.keep_final_stop;
@@ -78,16 +65,9 @@ void add_disasm_command(CLI::App& app, int& exit_status) {
   CLI::App* command =
       app.add_subcommand("disasm", "Turn a .bin program or a module's program memory back into TMCL mnemonics");
   command->add_option("program", options->binary, "The .bin file (8 bytes per instruction)");
-  CLI::Option* tcp = command->add_option("--tcp", options->tcp_address, "Read a module's memory over TCP, HOST:PORT");
-  CLI::Option* serial = command->add_option("--serial", options->serial_device,
-                                            "Read a module's memory over a serial device or pseudo-terminal");
-  tcp->excludes(serial);
-  command->add_option("--module-address", options->module_address, "Module address of the requests")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 255));
-  command->add_option("--timeout-ms", options->timeout_ms, "How long to wait for each reply (and to connect)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 3600 * 1000));
+  add_connection_options(*command, options->connection,
+                         {"Read a module's memory over TCP, HOST:PORT",
+                          "Read a module's memory over a serial device or pseudo-terminal"});
   command->add_option("--start", options->start, "First address to read from the module")->capture_default_str();
   command->add_option("--count", options->count,
                       "Number of instructions to read (default: up to the first NOP, command 0, that ends a download)");

@@ -38,8 +38,7 @@ void add_eds_command(CLI::App& app, int& exit_status) {
                                          ? tools::write_module_eds(*module, node_id)
                                          : Error{"module \"" + options->module + "\" has no CANopen object dictionary"};
     if (!text) {
-      print_error(text.error() + " (available: " + canopen_modules + ")");
-      exit_status = kExitUsageError;
+      exit_status = usage_error(text.error() + " (available: " + canopen_modules + ")");
       return;
     }
     if (options->output.empty()) {
@@ -50,12 +49,7 @@ void add_eds_command(CLI::App& app, int& exit_status) {
     std::ofstream file(options->output, std::ios::binary | std::ios::trunc);
     file << *text;
     file.close();
-    if (!file) {
-      print_error("cannot write " + options->output);
-      exit_status = kExitUsageError;
-      return;
-    }
-    exit_status = kExitSuccess;
+    exit_status = file ? kExitSuccess : usage_error("cannot write " + options->output);
   });
 }
 

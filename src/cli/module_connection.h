@@ -1,5 +1,6 @@
-// The options with which the program commands (`motwin download|start|stop|step|status`) reach
-// a module: --tcp HOST:PORT or --serial DEVICE, --module-address, --timeout-ms.
+// The options with which the commands that talk TMCL to a module (`motwin tmcl|download|disasm|
+// start|stop|step|status`) reach it: --tcp HOST:PORT or --serial DEVICE, --module-address,
+// --timeout-ms.
 #pragma once
 
 #include <chrono>
@@ -21,16 +22,22 @@ struct ModuleConnection {
   uint8_t address() const { return static_cast<uint8_t>(module_address); }
 };
 
-inline void add_connection_options(CLI::App& command, ModuleConnection& connection) {
-  CLI::Option* tcp =
-      command.add_option("--tcp", connection.tcp_address, "The module's TMCL-over-TCP endpoint (motwin serve), HOST:PORT");
-  CLI::Option* serial = command.add_option("--serial", connection.serial_device,
-                                           "The module's serial device or pseudo-terminal (115200 bit/s)");
+// The help of the options, as a command words them.
+struct ConnectionHelp {
+  std::string tcp = "The module's TMCL-over-TCP endpoint (motwin serve), HOST:PORT";
+  std::string serial = "The module's serial device or pseudo-terminal (115200 bit/s)";
+  std::string module_address = "Module address of the requests";
+  std::string timeout = "How long to wait for each reply (and to connect)";
+};
+
+inline void add_connection_options(CLI::App& command, ModuleConnection& connection, const ConnectionHelp& help = {}) {
+  CLI::Option* tcp = command.add_option("--tcp", connection.tcp_address, help.tcp);
+  CLI::Option* serial = command.add_option("--serial", connection.serial_device, help.serial);
   tcp->excludes(serial);
-  command.add_option("--module-address", connection.module_address, "Module address of the requests")
+  command.add_option("--module-address", connection.module_address, help.module_address)
       ->capture_default_str()
       ->check(CLI::Range(0, 255));
-  command.add_option("--timeout-ms", connection.timeout_ms, "How long to wait for each reply (and to connect)")
+  command.add_option("--timeout-ms", connection.timeout_ms, help.timeout)
       ->capture_default_str()
       ->check(CLI::Range(1, 3600 * 1000));
 }

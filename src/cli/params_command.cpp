@@ -21,18 +21,16 @@ struct ParamsOptions {
 
 int run_params(const ParamsOptions& options) {
   if (options.module_name.empty()) {
-    print_error(fmt::format("--module is required (known modules: {})", host::module_names()));
-    return kExitUsageError;
+    return usage_error(fmt::format("--module is required (known modules: {})", host::module_names()));
   }
   const host::ModuleDescriptor* module = host::find_module_ignoring_case(options.module_name);
   if (module == nullptr) {
-    print_error(fmt::format("unknown module '{}' (known modules: {})", options.module_name, host::module_names()));
-    return kExitUsageError;
+    return usage_error(
+        fmt::format("unknown module '{}' (known modules: {})", options.module_name, host::module_names()));
   }
   const std::optional<tools::ListingFormat> format = tools::parse_listing_format(options.format_name);
   if (!format) {
-    print_error(fmt::format("unknown format '{}' (expected table, csv or markdown)", options.format_name));
-    return kExitUsageError;
+    return usage_error(fmt::format("unknown format '{}' (expected table, csv or markdown)", options.format_name));
   }
   std::cout << tools::format_parameter_listing(module->listing(), *format);
   return kExitSuccess;

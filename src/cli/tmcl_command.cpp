@@ -11,6 +11,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "cli/module_connection.h"
 #include "core/tmcl/status.h"
 #include "tools/tmcl_client.h"
 #include "tools/tmcl_mnemonics.h"
@@ -19,10 +20,7 @@ namespace motwin::cli {
 namespace {
 
 struct TmclOptions {
-  std::string tcp_address;
-  std::string serial_device;
-  int module_address = tools::kDefaultModuleAddress;
-  int timeout_ms = static_cast<int>(tools::kDefaultReplyTimeout.count());
+  ModuleConnection connection;
   std::vector<std::string> instruction_words;
 };
 
@@ -58,35 +56,19 @@ std::string join_words(const std::vector<std::string>& words) {
 }
 
 int run_tmcl(const TmclOptions& options) {
-  if (options.tcp_address.empty() == options.serial_device.empty()) {
-    print_error("give exactly one of --tcp HOST:PORT or --serial DEVICE");
-    return kExitUsageError;
+  const ModuleConnection& connection = options.connection;
+  if (connection.tcp_address.empty() == connection.serial_device.empty()) {
+    return usage_error("give exactly one of --tcp HOST:PORT or --serial DEVICE");
   }
   if (options.instruction_words.empty()) {
-    print_error("no instruction given: expected for example 'GAP 52 0' (see motwin tmcl --help)");
-    return kExitUsageError;
+    return usage_error("no instruction given: expected for example 'GAP 52 0' (see motwin tmcl --help)");
   }
   const Result<tmcl::Instruction> instruction = tools::parse_instruction(join_words(options.instruction_words));
-  if (!instruction) {
-    print_error(instruction.error());
-    return kExitUsageError;
-  }
-
-  Result<tools::TmclClient> client =
-      options.tcp_address.empty()
-          ? tools::TmclClient::open_serial(options.serial_device)
-          : tools::TmclClient::connect_tcp(options.tcp_address, std::chrono::milliseconds(options.timeout_ms));
-  if (!client) {
-    print_error(client.error());
-    return kExitUsageError;
-  }
-  client->set_reply_timeout(std::chrono::milliseconds(options.timeout_ms));
-  const Result<tools::TmclReply> reply =
-      client->request(instruction.value(), static_cast<uint8_t>(options.module_address));
-  if (!reply) {
-    print_error(reply.error());
-    return kExitUsageError;
-  }
+  if (!instruction) return usage_error(instruction.error());
+  Result<tools::TmclClient> client = connect(connection);
+  if (!client) return usage_error(client.error());
+  const Result<tools::TmclReply> reply = client->request(instruction.value(), connection.address());
+  if (!reply) return usage_error(reply.error());
 
   switch (reply->kind) {
     case tools::ReplyKind::kNone:
@@ -111,16 +93,9 @@ int run_tmcl(const TmclOptions& options) {
 void add_tmcl_command(CLI::App& app, int& exit_status) {
   auto options = std::make_shared<TmclOptions>();
   CLI::App* command = app.add_subcommand("tmcl", "Send one TMCL instruction to a module and print its reply");
-  CLI::Option* tcp = command->add_option("--tcp", options->tcp_address, "TMCL-over-TCP endpoint, HOST:PORT");
-  CLI::Option* serial =
-      command->add_option("--serial", options->serial_device, "Serial device or pseudo-terminal (115200 bit/s)");
-  tcp->excludes(serial);
-  command->add_option("--module-address", options->module_address, "Module address of the request")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 255));
-  command->add_option("--timeout-ms", options->timeout_ms, "How long to wait for the reply (and to connect)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 3600 * 1000));
+  add_connection_options(*command, options->connection,
+                         {"TMCL-over-TCP endpoint, HOST:PORT", "Serial device or pseudo-terminal (115200 bit/s)",
+                          "Module address of the request", "How long to wait for the reply (and to connect)"});
   command->add_option("instruction", options->instruction_words,
                       "MNEMONIC OPERANDS... (TMCL-IDE syntax) or CMD [TYPE [MOTOR [VALUE]]]");
   command->footer(help_footer());
