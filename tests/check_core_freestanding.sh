@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Proves the core is firmware-like (DESIGN.md layer 1): the archive references no OS call, no
-# heap, no exceptions and no RTTI, and no core source includes an OS or I/O header.
+# Proves the core is firmware-like (docs/architecture.md "Principles", layer 1): the archive
+# references no OS call, no heap, no exceptions and no RTTI, and no core source includes an OS or
+# I/O header.
 # Usage: check_core_freestanding.sh <libmotwin_core.a> <src/core dir>
 set -euo pipefail
 archive=$1

@@ -1,8 +1,9 @@
 // The in-process virtual CAN bus: simulated nodes (virtual modules) and client endpoints
 // (socketcand connections, later SLCAN and SocketCAN) attach to it, and every frame one of them
-// sends reaches every other attached endpoint, never the sender itself (a CAN controller does
-// not receive its own frames, and python-canopen's PDO logic is confused by echoes:
-// notes/canopen.md). Frames arrive in the order they were sent (no arbitration).
+// sends reaches every other attached endpoint, never the sender itself (a CAN controller does not
+// receive its own frames, and python-canopen's PDO logic is confused by echoes: docs/canopen.md
+// "Reaching a virtual bus without kernel CAN"). Frames arrive in the order they were sent (no
+// arbitration).
 //
 // Bus load: with a bit rate set, each frame occupies the bus for its exact bit count (stuff bits
 // included, host/can_bit_timing.h) starting when the bus is free. Its timestamp is the simulated

@@ -1,6 +1,7 @@
 // The socketcand ASCII protocol, as python-can 4.1.0's `socketcand` interface speaks it
-// (notes/canopen.md): elements `< ... >` with no line terminator, `< send ID LEN B0 B1 ... >`
-// from the client, `< frame ID SEC.USEC HEXDATA >` to it. Pure text handling, no sockets.
+// (docs/canopen.md "Reaching a virtual bus without kernel CAN"): elements `< ... >` with no line
+// terminator, `< send ID LEN B0 B1 ... >` from the client, `< frame ID SEC.USEC HEXDATA >` to it.
+// Pure text handling, no sockets.
 #pragma once
 
 #include <cstddef>

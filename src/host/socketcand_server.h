@@ -1,7 +1,7 @@
 // A socketcand-protocol TCP server on the virtual CAN bus: what python-can's
-// `interface='socketcand'` (and through it python-canopen) connects to when there is no kernel
-// CAN (notes/canopen.md). Every client is a bus endpoint: it sees every frame of the bus except
-// its own, from the moment it is in raw mode.
+// `interface='socketcand'` (and through it python-canopen) connects to when there is no kernel CAN
+// (docs/canopen.md "Reaching a virtual bus without kernel CAN"). Every client is a bus endpoint: it
+// sees every frame of the bus except its own, from the moment it is in raw mode.
 //
 // Session, exactly as python-can 4.1.0 expects it (each server element in its own write; the
 // protocol logic is host/socketcand_session.h, without sockets):

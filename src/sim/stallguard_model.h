@@ -1,7 +1,8 @@
-// What a TMC5160-class driver's StallGuard2 / StallGuard4 measurement shows for the simulated
-// motor (TMCM-3216 manual 1.4.1, 1.4.3; notes motion-models.md). The sim board calls update()
-// once per tick after the plant advanced and hands the results to the firmware through
-// board::StepperFeedback (stallguard2_result, stallguard4_result, a measurement counter).
+// What a TMC5160-class driver's StallGuard2 / StallGuard4 measurement shows for the simulated motor
+// (TMCM-3216 manual 1.4.1, 1.4.3; docs/tmcm-3216-drive.md "StallGuard2, StallGuard4 and CoolStep").
+// The sim board calls update() once per tick after the plant advanced and hands the results to the
+// firmware through board::StepperFeedback (stallguard2_result, stallguard4_result, a measurement
+// counter).
 //
 // The driver measures once per full step of its microstep sequencer (drive.electrical_angle),
 // so the model integrates over each full step of the field:

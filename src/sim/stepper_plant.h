@@ -31,7 +31,7 @@ struct StepperMotorDescription {
 
   double holding_torque_nm() const { return torque_constant_nm_per_a * rated_current_a; }
 
-  static StepperMotorDescription nema17();  // motion-models.md values
+  static StepperMotorDescription nema17();  // docs/stepper-motion.md "Hybrid stepper model (`sim::StepperPlant`)"
   static StepperMotorDescription nema23();  // 2.8 A, about 1 N m holding torque (TMCM-142 default)
 };
 

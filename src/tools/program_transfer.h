@@ -1,6 +1,6 @@
 // Moving a TMCL program between a host and a module's program memory over a TmclClient.
 //
-// Download, as the TMCL-IDE does it (notes/tmcl.md "Control commands"): 132 with the start
+// Download, as the TMCL-IDE does it (docs/tmcl-protocol.md "Control commands"): 132 with the start
 // address (reply 100), each instruction in turn (reply 101, "stored"), a trailing NOP (command
 // 0, reply 101), then 133 (reply 100).
 //

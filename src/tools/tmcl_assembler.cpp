@@ -27,8 +27,8 @@ constexpr size_t kMaxIncludeDepth = 32;
 constexpr int64_t kValueMin = std::numeric_limits<int32_t>::min();
 constexpr int64_t kValueMax = std::numeric_limits<uint32_t>::max();
 
-// The axis names every TMCL-IDE program may use (notes/tmcl.md; TMCLParam.tmc defines them too,
-// with the same values, which is allowed).
+// The axis names every TMCL-IDE program may use (docs/tmcl-protocol.md "TMCL-IDE program syntax";
+// TMCLParam.tmc defines them too, with the same values, which is allowed).
 constexpr std::string_view kBuiltInMotors[] = {"Motor0", "Motor1", "Motor2", "Motor3", "Motor4", "Motor5"};
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }

@@ -1,4 +1,4 @@
-// The TMCL assembler: `.tmc` source as the TMCL-IDE's TMCL creator reads it (notes/tmcl.md
+// The TMCL assembler: `.tmc` source as the TMCL-IDE's TMCL creator reads it (docs/tmcl-protocol.md
 // "TMCL-IDE program syntax", TMCM-1636 manual chapters 1.3, 2.6 and 6) to the instructions that
 // a download stores in program memory. docs/assembler.md is the syntax reference.
 //
@@ -26,7 +26,7 @@
 
 namespace motwin::tools {
 
-// Program memory of the TMCM-1636 and TMCM-142 (notes/tmcl.md).
+// Program memory of the TMCM-1636 and TMCM-142 (docs/tmcl-protocol.md "Control commands").
 inline constexpr size_t kDefaultProgramMemorySize = 2048;
 
 struct SourceLocation {

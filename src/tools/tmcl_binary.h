@@ -1,6 +1,7 @@
-// The `.bin` program format of the TMCL-IDE's binary export (notes/tmcl.md): 8 bytes per
-// instruction, in address order: command, type, motor/bank, value (big-endian, 4 bytes) and
-// the 8-bit sum of those 7 bytes. No header; the file length is 8 x the instruction count.
+// The `.bin` program format of the TMCL-IDE's binary export (docs/tmcl-protocol.md
+// "TMCL-IDE program syntax"): 8 bytes per instruction, in address order: command, type, motor/bank,
+// value (big-endian, 4 bytes) and the 8-bit sum of those 7 bytes. No header; the file length is 8 x
+// the instruction count.
 #pragma once
 
 #include <array>

@@ -17,7 +17,7 @@
 namespace motwin::tools {
 
 inline constexpr std::chrono::milliseconds kDefaultReplyTimeout{1000};
-inline constexpr uint8_t kDefaultModuleAddress = 1;  // DESIGN.md errata: module 1, host 2
+inline constexpr uint8_t kDefaultModuleAddress = 1;  // docs/decisions.md "Errata in the manuals": module 1, host 2
 
 enum class ReplyKind : uint8_t {
   kNormal,
@@ -37,7 +37,7 @@ struct TmclReply {
   std::string version_string;  // kVersionString only
 };
 
-// What a request's reply looks like (notes/tmcl.md "Firmware version", "Control commands").
+// What a request's reply looks like (docs/tmcl-protocol.md "Firmware version", "Control commands").
 ReplyKind expected_reply_kind(const tmcl::Instruction& request);
 
 // Checks and decodes the reply bytes to `request`: checksum, and that a normal reply answers

@@ -1,8 +1,8 @@
 // TMCL instructions as TMCL-IDE writes them ("MVP ABS, 0, 90000"): the declarative table of
 // mnemonics, command numbers, operand layouts and symbolic operand names (TMCM-1636 manual
-// chapter 2, notes/tmcl.md; the data lives in core/tmcl/mnemonic_table.h, shared with the
-// firmware's ASCII interface), and a parser from one line of text to an Instruction. Used by the
-// `motwin tmcl` client, the TMCL assembler and the disassembler.
+// chapter 2, docs/tmcl-protocol.md "Code tables"; the data lives in core/tmcl/mnemonic_table.h,
+// shared with the firmware's ASCII interface), and a parser from one line of text to an
+// Instruction. Used by the `motwin tmcl` client, the TMCL assembler and the disassembler.
 #pragma once
 
 #include <cstdint>

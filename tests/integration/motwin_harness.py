@@ -35,7 +35,7 @@ MODULE_ADDRESS = 1
 HOST_ADDRESS = 2
 FRAME_LENGTH = 9
 
-# Command numbers (TMCM-1636 manual table 4, notes/tmcl.md).
+# Command numbers (TMCM-1636 manual table 4; docs/tmcl-protocol.md "Control commands").
 ROR, ROL, MST, MVP, SAP, GAP, STAP, RSAP, SGP, GGP, STGP, RSGP = 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12
 GET_VERSION = 136
 FACTORY_DEFAULTS = 137

@@ -2,11 +2,11 @@
 """SLCAN over TCP (`--can slcan-tcp:127.0.0.1:0`) with Debian's python3-can (`interface='slcan'`,
 channel `socket://127.0.0.1:PORT`, the pyserial URL): NMT reset and boot-up, SDO expedited and
 segmented, heartbeat, and one bus shared with a socketcand client (each sees the other's frames,
-neither sees its own). The rest of the checklist of notes/canopen.md over SLCAN too: PDO
-reconfiguration in python-canopen's order, SYNC-driven and event-timer TPDOs, RPDO length EMCYs,
-NMT transitions, store/restore across a restart, LSS configure, store and fastscan. Plus the
-adapter protocol by hand: version, status, errors for frames while closed, bit rate change
-refused while open, garbage lines answered with BEL.
+neither sees its own). The rest of the checklist of docs/canopen.md
+("Device contract masters rely on") over SLCAN too: PDO reconfiguration in python-canopen's order,
+SYNC-driven and event-timer TPDOs, RPDO length EMCYs, NMT transitions, store/restore across a
+restart, LSS configure, store and fastscan. Plus the adapter protocol by hand: version, status,
+errors for frames while closed, bit rate change refused while open, garbage lines answered with BEL.
 """
 
 import os

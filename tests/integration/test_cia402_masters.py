@@ -1,10 +1,11 @@
 #!/usr/bin/python3
-"""What CiA-402 masters do with the TMCM-3216 (notes/canopen.md "CiA-402 expectations of real
-masters"), as python-canopen's BaseNode402 and ros2_canopen send it, in raw frames over the
-socketcand server: 1000/67FF/6502 of every axis, state transitions with the exact controlwords
-and statusword masks, quick stop, fault and fault reset with EMCY 0000 naming the axis, 6060 = 0,
-the homing statusword contract of both masters, and PDO operation (RPDO controlword and target
-velocity, event-driven and synchronous TPDOs; axis 1's PDOs remapped in python-canopen's order).
+"""What CiA-402 masters do with the TMCM-3216 (docs/canopen.md
+"CiA-402 expectations of real masters"), as python-canopen's BaseNode402 and ros2_canopen send
+it, in raw frames over the socketcand server: 1000/67FF/6502 of every axis, state transitions
+with the exact controlwords and statusword masks, quick stop, fault and fault reset with EMCY 0000
+naming the axis, 6060 = 0, the homing statusword contract of both masters, and PDO operation
+(RPDO controlword and target velocity, event-driven and synchronous TPDOs; axis 1's PDOs
+remapped in python-canopen's order).
 """
 
 import os

@@ -18,7 +18,7 @@ from motwin_harness import (
 def check_version(c):
     check_equal(c.version_string(), VERSION_STRING, "136 type 0 version characters")
     expect_reply(c.request(GET_VERSION, 1), GET_VERSION, STATUS_OK, VERSION_BINARY, "136 type 1")
-    # Test vector from notes/tmcl.md, byte for byte.
+    # Test vector from docs/tmcl-protocol.md "Test vectors", byte for byte.
     check_equal(c.request_raw(frame(GET_VERSION, 1)).hex(" "), "02 01 64 88 06 64 01 09 63", "136 type 1 raw reply")
     expect_reply(c.request(GET_VERSION, 2), GET_VERSION, STATUS_WRONG_TYPE, what="136 type 2")
     # The version string reply must not have left stray bytes behind.
@@ -26,7 +26,7 @@ def check_version(c):
 
 
 def check_manual_vectors(c):
-    """Frames printed in the manual (and notes/tmcl.md), sent byte for byte."""
+    """Frames printed in the manual (and docs/tmcl-protocol.md "Test vectors"), sent byte for byte."""
     # GAP 1, 0 (manual 2.6.6): AP 1 is a readable ADC value.
     r = parse_reply(c.request_raw(bytes.fromhex("01 06 01 00 00 00 00 00 08")))
     expect_reply(r, GAP, STATUS_OK, what="manual GAP 1, 0")
@@ -38,7 +38,7 @@ def check_manual_vectors(c):
     expect_reply(r, STGP, STATUS_OK, what="manual STGP 42, 2")
     r = parse_reply(c.request_raw(bytes.fromhex("01 0C 2A 02 00 00 00 00 39")))
     expect_reply(r, RSGP, STATUS_OK, what="manual RSGP 42, 2")
-    # ROR 0, 350 (notes/tmcl.md): the reply echoes the value.
+    # ROR 0, 350 (docs/tmcl-protocol.md "Test vectors"): the reply echoes the value.
     raw = c.request_raw(bytes.fromhex("01 01 00 00 00 00 01 5E 61"))
     check_equal(raw.hex(" "), "02 01 64 01 00 00 01 5e c7", "reply to ROR 0, 350")
     check_equal(c.gap(40), 350, "AP 40 after ROR 0, 350")
@@ -243,7 +243,7 @@ def check_checksum_error(c):
     bad = bytearray(frame(GAP, 43))
     bad[8] = (bad[8] + 1) & 0xFF
     raw = c.request_raw(bytes(bad))
-    # Status 1, command 0, value 0 (notes/tmcl.md).
+    # Status 1, command 0, value 0 (docs/tmcl-protocol.md "Test vectors").
     check_equal(raw.hex(" "), "02 01 01 00 00 00 00 00 04", "reply to a checksum error")
     bad = bytearray(frame(SAP, 43, 0, 1111))
     bad[8] ^= 0x55

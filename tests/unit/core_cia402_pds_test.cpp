@@ -1,5 +1,6 @@
 // The CiA-402 power drive system state machine: the controlwords python-canopen and ros2_canopen
-// write, and the statusword values (masks of notes/canopen.md) they expect.
+// write, and the statusword values (masks of docs/canopen.md
+// "CiA-402 expectations of real masters") they expect.
 #include <gtest/gtest.h>
 
 #include "core/cia402/power_drive_system.h"

@@ -1,5 +1,6 @@
 // Every "Binary Form" example frame of the TMCM-1636 manual (chapter 2), sent to the engine,
-// with the reply this module gives (errata: DESIGN.md; decisions: docs/decisions.md).
+// with the reply this module gives (errata and decisions: docs/decisions.md,
+// "Errata in the manuals" first).
 #include <gtest/gtest.h>
 
 #include "support/tmcm1636_rig.h"

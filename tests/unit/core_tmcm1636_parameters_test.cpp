@@ -24,8 +24,8 @@ TEST(Tmcm1636Parameters, axis_table_has_every_row_of_manual_table_11) {
 }
 
 TEST(Tmcm1636Parameters, global_table_has_table_13_plus_gp_85_and_129) {
-  // GP 85 is described in manual 6.4, GP 129 (download mode) in notes/tmcl.md; GP 67 (ASCII
-  // interface) is a Motwin extension (docs/ascii-mode.md).
+  // GP 85 is described in manual 6.4, GP 129 (download mode) in docs/tmcl-protocol.md
+  // "Control commands"; GP 67 (ASCII interface) is a Motwin extension (docs/ascii-mode.md).
   std::set<int> table;
   for (const auto& row : Tmcm1636::global_parameters().rows()) table.insert(row.info.number);
   EXPECT_EQ(table, (std::set<int>{65, 66, 67, 69, 70, 71, 75, 76, 77, 85, 128, 129, 130, 132}));

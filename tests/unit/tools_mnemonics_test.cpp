@@ -31,7 +31,8 @@ struct ManualFrame {
 };
 
 // The "Binary Form" examples of the TMCM-1636 manual chapter 2 (RSAP with its checksum
-// corrected, DESIGN.md errata; STAP as its binary form shows it), and notes/tmcl.md vectors.
+// corrected, docs/decisions.md "Errata in the manuals"; STAP as its binary form shows it), and
+// docs/tmcl-protocol.md "Test vectors".
 constexpr ManualFrame kManualFrames[] = {
     {"ROR 0, 51200", "01 01 00 00 00 00 C8 00 CA"},
     {"ROR 0, 350", "01 01 00 00 00 00 01 5E 61"},

@@ -60,7 +60,7 @@ TEST(ParameterListing, tmcm1636_lists_every_table_row_and_the_user_variables) {
 
   const ListedParameter* serial_address = find_parameter(listing, ParameterKind::kGlobal, 0, 66);
   ASSERT_NE(serial_address, nullptr);
-  EXPECT_EQ(serial_address->default_value, 1);  // DESIGN.md errata: module address 1
+  EXPECT_EQ(serial_address->default_value, 1);  // docs/decisions.md "Errata in the manuals"
 
   const ListedParameter* storable = find_parameter(listing, ParameterKind::kGlobal, 2, 55);
   ASSERT_NE(storable, nullptr);

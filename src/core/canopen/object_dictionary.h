@@ -1,5 +1,5 @@
 // The CANopen object dictionary: every object a master can reach by index and sub-index,
-// described as data (DESIGN.md "One declarative source per module"). A module lists its objects
+// described as data (docs/architecture.md "Principles"). A module lists its objects
 // as EntryRow tables, one row per sub-index with the manual's columns: index, sub-index, names,
 // data type, access (ro/wo/rw/const), PDO mapping, value range and default. Rows bind to the
 // module's typed state with small function pointers, the way params::ParameterRow does for TMCL.

@@ -1,6 +1,6 @@
 // CoolStep (SmartEnergy): load-adaptive current scaling from the StallGuard2 load value, the
 // regulation a TMC5160-class driver runs once per StallGuard2 measurement (TMCM-3216 manual
-// 1.4.2 and 4.1, objects 2098..209C, 20A5; notes motion-models.md).
+// 1.4.2 and 4.1, objects 2098..209C, 20A5; docs/tmcm-3216-drive.md "CoolStep (2098..209C, 20A5)").
 //
 // The current is held as the driver's 5-bit current scale CS (0..31, the run current 2003 / 8):
 // the run scale is the ceiling, 1/2 or 1/4 of it (2098) the floor. For each measurement below

@@ -1,10 +1,10 @@
-// The TMC457 easyPID (notes/tmcm142.md): a position regulator on the encoder that corrects the
-// microstep velocity of a stepper. pid_e = encoder - actual (ramp) position, clipped to +-2^23;
-// P part pid_e * P / 256; I part from the error sum (clipped to +-Iclip * 2^16) * I / 256 / 256;
-// D part D * (pid_e of the last D sample - pid_e now), that difference clipped to +-127; the sum,
-// clipped to +-dv_clip, is the velocity correction. Each part pushes pid_e back towards 0: an
-// encoder that lags behind the ramp speeds the microsteps up. Velocities are TMC457 units
-// (µsteps/t, docs/tmcm-142.md). Integer arithmetic as on the chip.
+// The TMC457 easyPID (docs/tmcm-142.md "Encoder, easyPID and deviation"): a position regulator on
+// the encoder that corrects the microstep velocity of a stepper. pid_e = encoder - actual (ramp)
+// position, clipped to +-2^23; P part pid_e * P / 256; I part from the error sum (clipped to
+// +-Iclip * 2^16) * I / 256 / 256; D part D * (pid_e of the last D sample - pid_e now), that
+// difference clipped to +-127; the sum, clipped to +-dv_clip, is the velocity correction. Each part
+// pushes pid_e back towards 0: an encoder that lags behind the ramp speeds the microsteps up.
+// Velocities are TMC457 units (µsteps/t, docs/tmcm-142.md). Integer arithmetic as on the chip.
 #pragma once
 
 #include <cstdint>

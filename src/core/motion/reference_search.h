@@ -1,4 +1,5 @@
-// Reference search (RFS) of a single stepper axis, TMCM-142 style (notes/tmcm142.md):
+// Reference search (RFS) of a single stepper axis, TMCM-142 style (docs/tmcm-142.md
+// "Reference search (RFS, AP 193..196)"):
 //   mode 1: the left switch only;
 //   mode 2: the right switch, then the left switch; the travel between them is measured;
 //   mode 3: as 2, and the reference point is the centre of the left switch's two switching

@@ -1,7 +1,7 @@
 // The declarative description of one exposed parameter (axis or global), as the manuals'
 // tables give it: number, name, range, default, access letters, unit. Module tables are
 // arrays of ParameterRow; the dispatcher, range checks, EEPROM layout and the CLI listing
-// all walk those arrays (DESIGN.md "One declarative source per module").
+// all walk those arrays (docs/architecture.md "Principles").
 #pragma once
 
 #include <cstdint>
@@ -112,7 +112,7 @@ constexpr std::string_view unit_symbol(Unit unit) {
 }
 
 // Descriptions of parameters whose number or meaning no public source gives start with this tag
-// (`motwin params` and the module docs show it; TMCM-142, notes/tmcm142.md).
+// (`motwin params` and the module docs show it; TMCM-142: docs/tmcm-142.md "Sources").
 inline constexpr std::string_view kMotwinDecisionTag = "[Motwin decision] ";
 constexpr bool is_motwin_decision(std::string_view description) { return description.starts_with(kMotwinDecisionTag); }
 

@@ -1,5 +1,5 @@
-// The TMCL ASCII interface (TMCM-142 manual 6.6, notes/tmcl.md "ASCII interface"): a terminal
-// drives the module line by line in TMCL-IDE syntax instead of 9-byte frames.
+// The TMCL ASCII interface (TMCM-142 manual 6.6, docs/tmcl-protocol.md "ASCII interface"): a
+// terminal drives the module line by line in TMCL-IDE syntax instead of 9-byte frames.
 //
 //   AMVP ABS, 0, 50000<CR>      ->  BA 100 50000<CR>
 //   A GAP 52, 0<CR>             ->  BA 100 -5000<CR>

@@ -95,7 +95,8 @@ CanResponse serve_can_frame(TmclEngine& engine, const can::CanFrame& frame, Chan
       response.has_reply = false;
       return response;
     case ReplyKind::kVersionString: {
-      // The 8 version characters are the data (notes/tmcl.md), whatever the request's length.
+      // The 8 version characters are the data, whatever the request's length
+      // (docs/tmcl-protocol.md "CAN framing").
       response.reply.id = now.send_id;
       response.reply.extended = frame.extended || now.send_id > can::kMaxStandardId;
       response.reply.dlc = 8;

@@ -1,10 +1,10 @@
-// TMCL over CAN (TMCM-1636 manual 2.1-2.2 notes, notes/tmcl.md "CAN framing"): a request is a
-// frame on the module's receive ID (GP 71) carrying command, type, motor and the value
-// (big-endian), 7 data bytes or 8 (PyTrinamic lets the serial checksum byte ride along; it is
-// not checked: CAN has its own CRC). The reply goes out on the send ID (GP 70) with the receive
-// ID's low byte, status, command and value, as long as the request was (8: padded with 0).
-// Any TMCL module with GP 69/70/71 uses this link unchanged; the IDs are read from the module's
-// own parameter table, so SGP 70/71 take effect with the very next frame.
+// TMCL over CAN (TMCM-1636 manual 2.1-2.2 notes, docs/tmcl-protocol.md "CAN framing"): a request is
+// a frame on the module's receive ID (GP 71) carrying command, type, motor and the value
+// (big-endian), 7 data bytes or 8 (PyTrinamic lets the serial checksum byte ride along; it is not
+// checked: CAN has its own CRC). The reply goes out on the send ID (GP 70) with the receive ID's
+// low byte, status, command and value, as long as the request was (8: padded with 0). Any TMCL
+// module with GP 69/70/71 uses this link unchanged; the IDs are read from the module's own
+// parameter table, so SGP 70/71 take effect with the very next frame.
 #pragma once
 
 #include <cstdint>

@@ -17,7 +17,8 @@ struct FirmwareIdentity {
   uint8_t version_minor;      // 9
   char version_string[9];     // "1636V109": 8 characters, never containing 'B'
 
-  // Command 136 type 1 (notes/tmcl.md): module << 16 | major << 8 | minor.
+  // Command 136 type 1: module << 16 | major << 8 | minor (docs/tmcl-protocol.md
+  // "Firmware version").
   constexpr int32_t binary_version() const {
     return static_cast<int32_t>((static_cast<uint32_t>(module_number) << 16) |
                                 (static_cast<uint32_t>(version_major) << 8) | version_minor);
@@ -81,10 +82,10 @@ class TmclDevice {
     return Status::kInvalidCommand;
   }
 
-  // Coordinates (TMCM-142 generation, notes/tmcl.md): SCO 30, GCO 31, CCO 32, ACO 39 (ACO is
-  // set_coordinate with the accumulator). motor 255 selects the special forms `SCO n, 255, 0`
-  // (RAM to EEPROM) and `GCO n, 255, 0` (EEPROM to RAM). Modules without coordinates answer
-  // status 2 (invalid command).
+  // Coordinates (TMCM-142 generation, docs/tmcl-protocol.md "Interpreter model"): SCO 30, GCO 31,
+  // CCO 32, ACO 39 (ACO is set_coordinate with the accumulator). motor 255 selects the special
+  // forms `SCO n, 255, 0` (RAM to EEPROM) and `GCO n, 255, 0` (EEPROM to RAM). Modules without
+  // coordinates answer status 2 (invalid command).
   virtual Status set_coordinate(uint8_t /*number*/, uint8_t /*motor*/, int32_t /*position*/) {
     return Status::kInvalidCommand;
   }

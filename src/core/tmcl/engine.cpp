@@ -12,12 +12,12 @@ CommandResult read_result(Status status, int32_t value, int32_t echo) {
   return CommandResult{Status::kOk, value, ReplyKind::kNormal, true};
 }
 
-// CLE types (notes/tmcl.md): ALL 0, ETO 1, EAL 2, EDV 3, EPO 4, ESD 5.
+// CLE types (docs/tmcl-protocol.md "Code tables"): ALL 0, ETO 1, EAL 2, EDV 3, EPO 4, ESD 5.
 constexpr uint8_t kCleMasks[] = {0xFF, kErrorTimeout, kErrorExternalAlarm, kErrorDeviation, kErrorPosition,
                                  kErrorShutdown};
 
-// CALC/CALCX operations (notes/tmcl.md): ADD 0 .. LOAD 9, CALCX adds SWAP 10. Arithmetic
-// wraps as 32-bit two's complement. Division or modulo by zero leaves the accumulator
+// CALC/CALCX operations (docs/tmcl-protocol.md "Code tables"): ADD 0 .. LOAD 9, CALCX adds SWAP 10.
+// Arithmetic wraps as 32-bit two's complement. Division or modulo by zero leaves the accumulator
 // unchanged and answers status 4 (docs/decisions.md).
 Status calculate(TmclRuntime& r, uint8_t operation, int32_t operand, bool with_x) {
   const auto a = static_cast<uint32_t>(r.accumulator);
@@ -87,7 +87,7 @@ void TmclEngine::power_up() {
 }
 
 // Download mode (command 132): instructions from the host are stored, not executed, and
-// answered with status 101 (notes/tmcl.md).
+// answered with status 101 (docs/tmcl-protocol.md "Control commands").
 CommandResult TmclEngine::store_downloaded(const Instruction& in) {
   TmclRuntime& runtime = device_.runtime();
   ProgramMemory* memory = device_.program_memory();

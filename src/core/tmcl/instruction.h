@@ -17,7 +17,8 @@ struct Instruction {
 // (TMCM-1636 manual 2.5.5); the interpreter loads it from CommandResult::value instead.
 enum class Origin : uint8_t { kHost, kProgram };
 
-// TMCL command numbers (TMCM-1636 manual table 4 and table 10; notes/tmcl.md).
+// TMCL command numbers (TMCM-1636 manual table 4 and table 10; docs/tmcl-protocol.md "Code tables",
+// "Control commands").
 namespace command {
 inline constexpr uint8_t kNop = 0;
 inline constexpr uint8_t kRor = 1;

@@ -229,8 +229,9 @@ void TmclInterpreter::execute(const Instruction& in, uint64_t now_us) {
   if (result.loads_accumulator) runtime_.accumulator = result.value;
 }
 
-// JC conditions (notes/tmcl.md): ZE/NZ/EQ/NE/GT/GE/LT/LE on the last COMP, then the error flags.
-// ZE and NZ test the difference of the COMP operands for zero, i.e. they equal EQ and NE.
+// JC conditions (docs/tmcl-protocol.md "Code tables"): ZE/NZ/EQ/NE/GT/GE/LT/LE on the last COMP,
+// then the error flags. ZE and NZ test the difference of the COMP operands for zero, i.e. they
+// equal EQ and NE.
 bool TmclInterpreter::condition_holds(uint8_t condition) const {
   const int32_t a = runtime_.compare_accumulator;
   const int32_t b = runtime_.compare_operand;

@@ -1,5 +1,5 @@
 // The TMCL interpreter: runs the stored program one instruction per control tick, interleaved
-// with host commands and the control loops (notes/tmcl.md "Interpreter model", TMCM-1636
+// with host commands and the control loops (docs/tmcl-protocol.md "Interpreter model", TMCM-1636
 // manual 2.6.15-2.6.26 and 6). Program flow (JA, JC, CSUB, RSUB, WAIT, STOP, VECT, EI, DI,
 // RETI) is executed here; every other instruction goes through TmclEngine::execute with
 // Origin::kProgram, and a read loads the accumulator.

@@ -1,8 +1,8 @@
-// TMCL mnemonics as plain data: mnemonic, command number, operand layout and the symbolic
-// operand names (TMCM-1636 manual table 4 and chapter 2.6; notes/tmcl.md "Code tables" for 13,
-// 25, 26, 30-32, 37-39). The one copy of this table: the ASCII interface of the core
-// (ascii_link.h) reads lines with it, and the host tools (tools/tmcl_mnemonics.h: `motwin tmcl`,
-// the assembler, the disassembler) build their parser and formatter on it.
+// TMCL mnemonics as plain data: mnemonic, command number, operand layout and the symbolic operand
+// names (TMCM-1636 manual table 4 and chapter 2.6; docs/tmcl-protocol.md "Code tables" for 13, 25,
+// 26, 30-32, 37-39). The one copy of this table: the ASCII interface of the core (ascii_link.h)
+// reads lines with it, and the host tools (tools/tmcl_mnemonics.h: `motwin tmcl`, the assembler,
+// the disassembler) build their parser and formatter on it.
 //
 // Freestanding: constexpr arrays of string_view and span, no allocation.
 #pragma once

@@ -1,5 +1,5 @@
 // The TMCL registers shared by direct mode and stored programs: accumulator, X register,
-// comparison result and error flags (notes/tmcl.md "Interpreter model"). Direct-mode CLE
+// comparison result and error flags (docs/tmcl-protocol.md "Interpreter model"). Direct-mode CLE
 // clears the same flags a program tests with JC.
 #pragma once
 

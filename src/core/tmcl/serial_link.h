@@ -1,6 +1,6 @@
 // TMCL over a byte stream (RS485, RS232, USB virtual COM port, and TCP as PyTrinamic's
 // socket interface speaks it): 9-byte frames, address filter, checksum, reply encoding
-// (TMCM-1636 manual 2.1-2.2, notes/tmcl.md).
+// (TMCM-1636 manual 2.1-2.2, docs/tmcl-protocol.md "Serial and TCP framing").
 #pragma once
 
 #include <array>
@@ -26,7 +26,8 @@ Instruction decode_instruction(const Frame& frame);
 Frame encode_reply(uint8_t host_address, uint8_t module_address, const Reply& reply);
 
 // Collects bytes into frames. A gap longer than `resync_gap_us` between two bytes discards a
-// partial frame, so a host that lost byte sync recovers by pausing (notes/tmcl.md).
+// partial frame, so a host that lost byte sync recovers by pausing
+// (docs/tmcl-protocol.md "Serial and TCP framing").
 class SerialFrameDecoder {
  public:
   static constexpr uint32_t kDefaultResyncGapUs = 5000;

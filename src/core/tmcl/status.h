@@ -1,4 +1,4 @@
-// TMCL reply status codes (TMCM-1636 manual table 3, notes/tmcl.md).
+// TMCL reply status codes (TMCM-1636 manual table 3, docs/tmcl-protocol.md "Status codes").
 #pragma once
 
 #include <cstdint>

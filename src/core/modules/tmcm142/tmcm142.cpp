@@ -7,7 +7,7 @@ namespace {
 
 using tmcl::Status;
 
-// RFS types (notes/tmcl.md).
+// RFS types (docs/tmcl-protocol.md "Code tables").
 constexpr uint8_t kRfsStart = 0;
 constexpr uint8_t kRfsStop = 1;
 constexpr uint8_t kRfsStatus = 2;

@@ -1,7 +1,7 @@
 // The TMCM-142 module profile (firmware 142V1.06): single-axis stepper with the TMC457 feature set
-// (S-ramps, up to 1024 microsteps, ABN encoder with easyPID, reference search, coordinates) and
-// the TMCL ASCII interface, on the TMCL module base (core/tmcl/tmcl_module.h). Parameter
-// numbers follow notes/tmcm142.md; the ones Motwin had to number are marked in the tables
+// (S-ramps, up to 1024 microsteps, ABN encoder with easyPID, reference search, coordinates) and the
+// TMCL ASCII interface, on the TMCL module base (core/tmcl/tmcl_module.h). Parameter numbers follow
+// docs/tmcm-142.md "Sources"; the ones Motwin had to number are marked in the tables
 // (docs/tmcm-142.md).
 #pragma once
 
@@ -28,7 +28,8 @@ namespace motwin::modules::tmcm142 {
 // GP 84: where coordinates 1..20 live.
 enum class CoordinateStorage : int32_t { kRam = 0, kEeprom = 1 };
 
-// Bank 0 settings (notes/tmcm142.md, TMCM-351 V4.45 as the same generation's stand-in).
+// Bank 0 settings (docs/tmcm-142.md "Global parameters (bank 0)", TMCM-351 V4.45 as the same
+// generation's stand-in).
 struct GlobalConfig {
   int32_t eeprom_magic = 228;          // GP 64: another value re-initialises the image at power-up
   int32_t serial_baud_rate_code = 0;   // GP 65: 9600 bit/s (manual 5.1); no effect on a pseudo-terminal

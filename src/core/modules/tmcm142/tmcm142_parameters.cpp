@@ -1,7 +1,8 @@
-// The TMCM-142 parameter tables: the axis parameters of notes/tmcm142.md and the public V1.06
-// fragments (easyPID 32..40, encoder 41/42), plus the ones Motwin numbered itself (descriptions
-// tagged params::kMotwinDecisionTag), and the global parameters of bank 0, bound to the
-// module's config and state. Speeds and accelerations read and write in the units AP 255 selects.
+// The TMCM-142 parameter tables: the axis parameters of docs/tmcm-142.md "Sources" and the public
+// V1.06 fragments (easyPID 32..40, encoder 41/42), plus the ones Motwin numbered itself
+// (descriptions tagged params::kMotwinDecisionTag), and the global parameters of bank 0, bound to
+// the module's config and state. Speeds and accelerations read and write in the units AP 255
+// selects.
 #include <cmath>
 
 #include "core/modules/tmcm142/tmcm142.h"
@@ -152,7 +153,7 @@ const Tmcm142::Table& Tmcm142::axis_parameters() {
   return kTable;
 }
 
-// Bank 0. Section "Global parameters" of notes/tmcm142.md; every writable one below 128 is
+// Bank 0: docs/tmcm-142.md "Global parameters (bank 0)"; every writable one below 128 is
 // automatically stored (A), as on the TMCM-1636 (docs/decisions.md). GP 73 stores itself.
 // GP 128..132 come from the TMCL module base.
 const Tmcm142::Table& Tmcm142::global_parameters() {

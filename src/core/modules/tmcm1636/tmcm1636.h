@@ -22,7 +22,8 @@
 
 namespace motwin::modules::tmcm1636 {
 
-// Bank 0 settings (manual table 13). GP 66/76 defaults follow DESIGN.md errata (1 and 2).
+// Bank 0 settings (manual table 13). GP 66/76 defaults follow docs/decisions.md
+// "Errata in the manuals" (1 and 2).
 struct GlobalConfig {
   int32_t serial_baud_rate_code = 7;   // GP 65, 115200 bit/s; no effect on a pseudo-terminal
   int32_t serial_address = 1;          // GP 66

@@ -1,8 +1,8 @@
 // The TMCM-1636 servo cascade on the power-stage seam (manual chapter 5, table 11 numbers per
-// DESIGN.md errata): measurements from ADC counts and sensor counts, commutation angle, encoder
-// initialisation, position P -> velocity PI -> FOC flux/torque PI -> space-vector PWM, brake
-// output, brake chopper and protections. No plant knowledge: everything here would run on the
-// module's microcontroller. Structure and units: docs/tmcm-1636-servo.md.
+// docs/decisions.md "Errata in the manuals"): measurements from ADC counts and sensor counts,
+// commutation angle, encoder initialisation, position P -> velocity PI -> FOC flux/torque PI ->
+// space-vector PWM, brake output, brake chopper and protections. No plant knowledge: everything
+// here would run on the module's microcontroller. Structure and units: docs/tmcm-1636-servo.md.
 #include <cmath>
 
 #include "core/modules/tmcm1636/tmcm1636_axis.h"

@@ -157,8 +157,8 @@ const Tmcm1636::Table& Tmcm1636::axis_parameters() {
 }
 
 // Bank 0 (table 13). Section 4.1: "parameters between 64 and 128 are automatically stored",
-// so every writable one below 128 carries A. GP 66/76 defaults: DESIGN.md errata. GP 128..132
-// come from the TMCL module base.
+// so every writable one below 128 carries A. GP 66/76 defaults:
+// docs/decisions.md "Errata in the manuals". GP 128..132 come from the TMCL module base.
 const Tmcm1636::Table& Tmcm1636::global_parameters() {
   // clang-format off
   static constexpr Row kSettingRows[] = {

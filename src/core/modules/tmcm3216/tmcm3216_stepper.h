@@ -24,8 +24,8 @@
 
 namespace motwin::modules::tmcm3216 {
 
-// The driver chip's clock: TMC velocity registers are v x fCLK / 2^24 µsteps/s, the power-down
-// ramp steps 2^18 clocks (motion-models.md).
+// The driver chip's clock: TMC velocity registers are v x fCLK / 2^24 µsteps/s, the power-down ramp
+// steps 2^18 clocks (docs/tmcm-3216-drive.md "How it is put together", "The axis below the drive").
 inline constexpr double kDriverClockHz = 12e6;
 // 20A3 driver current ranges, mA peak (manual 4.2.36).
 inline constexpr int32_t kCurrentRangePeakMa[4] = {1000, 2000, 3000, 3000};

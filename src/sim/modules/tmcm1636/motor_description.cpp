@@ -70,8 +70,8 @@ MotorDescription large_48v() {
   m.source =
       "63 mm outrunner class (ODrive's D5065-270KV): 7 pole pairs, 0.039 ohm and 15.7 uH per "
       "phase, KV 270 rpm/V (torque constant 8.27/KV = 0.0306 N m/A), inertia 1e-4 kg m^2 "
-      "(notes/motion-models.md); hall sensors and an 8192-count ABN encoder (AMT102 at 2048 "
-      "lines); friction chosen";
+      "(docs/tmcm-1636-servo.md \"Presets\"); hall sensors and an 8192-count ABN encoder "
+      "(AMT102 at 2048 lines); friction chosen";
   m.kind = MotorKind::kBldc;
   m.pole_pairs = 7;
   m.resistance_ohm = 0.039;
