@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Proves the core is firmware-like (docs/architecture.md "Principles", layer 1): the archive
+# Proves the core is firmware-like (docs/architecture.md "Rules the core keeps"): the archive
 # references no OS call, no heap, no exceptions and no RTTI, and no core source includes an OS or
 # I/O header.
 # Usage: check_core_freestanding.sh <libmotwin_core.a> <src/core dir>
