@@ -179,6 +179,62 @@ TEST(Tmcm1636Servo, mvp_reaches_the_target_with_and_without_ramp) {
   }
 }
 
+// --- Trinamic's reference motor -------------------------------------------------------------
+
+sim::MotorDescription reference_motor() { return Tmcm1636ServoRig::preset("qbl4208-61-04-013"); }
+
+// Wired as on Trinamic's setup: the start-up image holds hall polarity 1 and encoder direction 1
+// (the examples' settings), and with them hall commutation, ABN initialised from the halls and a
+// position move work as on the bench.
+TEST(Tmcm1636ReferenceMotor, the_examples_sensor_settings_are_the_right_ones) {
+  Tmcm1636ServoRig rig(reference_motor());
+  EXPECT_EQ(rig.gap(90), 1);
+  EXPECT_EQ(rig.gap(91), 0);
+  EXPECT_EQ(rig.gap(101), 1);
+  rig.sap(45, 0);
+  rig.ror(1500);
+  rig.run_ms(500);
+  EXPECT_NEAR(rig.speed_rpm(), 1500.0, 20.0) << "hall commutation with AP 90 = 1";
+  EXPECT_NEAR(rig.gap(42), 1500, 30) << "encoder velocity counts forward with AP 101 = 1";
+  rig.ror(0);
+  rig.run_ms(300);
+  ASSERT_EQ(rig.sap(15, 3), 100);  // ABN commutation, initialised from the halls (AP 102 = 2)
+  rig.ror(1000);
+  const double init_ms = rig.run_until([&] { return rig.gap(103) == 0; }, 2000);
+  EXPECT_LT(init_ms, 2000);
+  rig.run_ms(500);
+  EXPECT_NEAR(rig.speed_rpm(), 1000.0, 15.0) << "ABN commutation after the initialisation";
+  rig.ror(0);
+  rig.run_ms(300);
+  const int32_t target = rig.gap(52) + 5 * 4096;
+  ASSERT_EQ(rig.mvp(target), 100);
+  const double ms = rig.run_until([&] { return rig.gap(55) == 1; }, 10000);
+  EXPECT_LT(ms, 10000) << "position reached";
+  rig.run_ms(300);
+  EXPECT_LE(std::abs(rig.gap(52) - target), 5) << "holds: AP 52 " << rig.gap(52);
+}
+
+// The other settings are wrong the way they are on a bench: hall polarity 0 commutates 180° off,
+// encoder direction 0 counts backwards, so the velocity the regulator sees has the wrong sign.
+TEST(Tmcm1636ReferenceMotor, the_default_sensor_settings_are_wrong_for_its_wiring) {
+  {
+    Tmcm1636ServoRig rig(reference_motor());
+    rig.sap(45, 0);
+    rig.sap(90, 0);
+    rig.ror(1500);
+    rig.run_ms(500);
+    EXPECT_GT(std::fabs(rig.speed_rpm() - 1500.0), 500.0) << "AP 90 = 0: " << rig.speed_rpm() << " rpm";
+  }
+  {
+    Tmcm1636ServoRig rig(reference_motor());
+    rig.sap(45, 0);
+    rig.sap(101, 0);
+    rig.ror(1500);
+    rig.run_ms(500);
+    EXPECT_GT(std::fabs(rig.speed_rpm() - 1500.0), 500.0) << "AP 101 = 0: " << rig.speed_rpm() << " rpm";
+  }
+}
+
 // --- Commutation modes -----------------------------------------------------------------------
 
 TEST(Tmcm1636Servo, open_loop_turns_the_motor_at_the_commanded_speed) {

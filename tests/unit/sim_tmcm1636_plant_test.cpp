@@ -215,7 +215,7 @@ TEST(MotorDescription, errors_name_the_file_and_the_problem) {
             "d.json: axis_parameters: axis parameter 42 is not stored in the EEPROM");
   EXPECT_EQ(parse_motor_description(R"({"type": "dc"})", "e.json").error(), "e.json: a DC motor needs torque_constant_nm_per_a");
   EXPECT_EQ(resolve_motor("fast-one").error(),
-            "unknown motor \"fast-one\" (expected ideal, default-24v, large-48v, dc-24v or a .json file)");
+            "unknown motor \"fast-one\" (expected ideal, default-24v, qbl4208-61-04-013, large-48v, dc-24v or a .json file)");
   EXPECT_FALSE(*resolve_motor("ideal"));
   EXPECT_TRUE(resolve_motor("ideal").error().empty());
 }

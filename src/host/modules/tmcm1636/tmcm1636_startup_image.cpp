@@ -44,6 +44,11 @@ std::optional<int32_t> coded(const std::optional<T>& setting, Code code) {
   return code(*setting);
 }
 
+// A flag setting as the firmware's 0/1 parameter.
+std::optional<int32_t> flag_value(const std::optional<bool>& setting) {
+  return coded(setting, [](bool on) -> int32_t { return on ? 1 : 0; });
+}
+
 // One named start-up value: its key in the description, the axis parameter of table 11 it goes
 // to, and its value there (none: not set, the factory default stays).
 struct NamedValue {
@@ -69,15 +74,19 @@ const NamedValue kNamedValues[] = {
     {"velocity_p", 72, [](const MotorDescription&, const StartupSettings& s) { return s.velocity_p; }},
     {"velocity_i", 73, [](const MotorDescription&, const StartupSettings& s) { return s.velocity_i; }},
     {"position_p", 74, [](const MotorDescription&, const StartupSettings& s) { return s.position_p; }},
+    {"hall_polarity_inverted", 90,
+     [](const MotorDescription&, const StartupSettings& s) { return flag_value(s.hall_polarity_inverted); }},
+    {"hall_direction_reversed", 91,
+     [](const MotorDescription&, const StartupSettings& s) { return flag_value(s.hall_direction_reversed); }},
     {"hall_interpolation", 92,
-     [](const MotorDescription&, const StartupSettings& s) {
-       return coded(s.hall_interpolation, [](bool on) -> int32_t { return on ? 1 : 0; });
-     }},
+     [](const MotorDescription&, const StartupSettings& s) { return flag_value(s.hall_interpolation); }},
     {"abn_encoder.counts_per_rev", 100,
      [](const MotorDescription& m, const StartupSettings&) -> std::optional<int32_t> {
        if (!m.abn.present) return std::nullopt;
        return m.abn.counts_per_rev;  // AP 100 counts per revolution: the encoder's resolution
      }},
+    {"encoder_direction_reversed", 101,
+     [](const MotorDescription&, const StartupSettings& s) { return flag_value(s.encoder_direction_reversed); }},
     {"encoder_alignment", 102,
      [](const MotorDescription&, const StartupSettings& s) { return coded(s.encoder_alignment, encoder_init_mode_of); }},
     {"brake_chopper_voltage_v", 141,

@@ -37,9 +37,9 @@ MotorDescription default_24v() {
   m.source =
       "42 mm 24 V BLDC motor with 4 pole pairs, hall sensors and a 1024-line (4096-count) ABN "
       "encoder, modelled on the datasheet of the Trinamic QBL4208-61-04-013 (line-to-line 0.8 ohm "
-      "and 1.2 mH, torque constant 0.035 N m/A, rotor inertia 48 g cm^2), the motor of the "
-      "TMCM-1636 examples in PyTrinamic; friction chosen for a no-load current of about 0.3 A at "
-      "4000 rpm";
+      "and 1.2 mH, torque constant 0.035 N m/A, rotor inertia 48 g cm^2) with plainly wired "
+      "sensors (no polarity or direction setting needed; for Trinamic's wiring see "
+      "qbl4208-61-04-013); friction chosen for a no-load current of about 0.3 A at 4000 rpm";
   m.kind = MotorKind::kBldc;
   m.pole_pairs = 4;
   m.resistance_ohm = 0.4;
@@ -57,6 +57,46 @@ MotorDescription default_24v() {
   s.open_loop_current_ma = 1000;
   s.current_p = 461;  // current loop at 3000 rad/s: P = L w, I = R w (docs/tmcm-1636-servo.md)
   s.current_i = 3932;
+  s.velocity_p = 1200;
+  s.velocity_i = 1200;
+  s.position_p = 300;
+  m.startup = s;
+  return m;
+}
+
+// Trinamic's reference motor, the one the TMCM-1636 examples of PyTrinamic name, with its sensors
+// wired as on Trinamic's setup: the examples set hall polarity AP 90 = 1 and encoder direction
+// AP 101 = 1, so here the hall levels are inverted and the encoder counts down for forward
+// rotation (docs/tmcm-1636-servo.md "Presets").
+MotorDescription qbl4208_61_04_013() {
+  MotorDescription m;
+  m.name = "qbl4208-61-04-013";
+  m.source =
+      "Trinamic QBL4208-61-04-013 (-1024-AT in the older order code), datasheet QBL4208-x-1k "
+      "Rev 1.40: 4 pole pairs, 24 V, 4000 rpm rated, 3.47 A rated, line-to-line 0.72 ohm and "
+      "1.2 mH, torque constant 0.036 N m/A, rotor inertia 48 g cm^2; hall sensors and a 4096-count "
+      "ABN encoder wired as on Trinamic's setup (hall polarity and encoder direction 1); friction "
+      "chosen for a no-load current of about 0.3 A at 4000 rpm";
+  m.kind = MotorKind::kBldc;
+  m.pole_pairs = 4;
+  m.resistance_ohm = 0.36;  // star equivalent of the delta winding: half the line-to-line value
+  m.inductance_d_h = 0.6e-3;
+  m.inductance_q_h = 0.6e-3;
+  m.flux_linkage_wb = 0.036 / (1.5 * 4);
+  m.rotor_inertia_kgm2 = 4.8e-6;
+  m.viscous_friction_nm_s = 1.5e-5;
+  m.coulomb_friction_nm = 0.004;
+  m.initial_angle_deg = 40.0;
+  m.hall.inverted = true;
+  m.abn = {true, 4096, 200.0, true};
+  m.supply = {24.0, 0.1, 470e-6, 10.0, false};
+  StartupSettings s = bldc_startup();
+  s.hall_polarity_inverted = true;  // AP 90 = 1, as the examples set it
+  s.encoder_direction_reversed = true;  // AP 101 = 1
+  s.max_current_ma = 2000;
+  s.open_loop_current_ma = 1000;
+  s.current_p = 461;  // current loop at 3000 rad/s: P = L w, I = R w (docs/tmcm-1636-servo.md)
+  s.current_i = 3539;
   s.velocity_p = 1200;
   s.velocity_i = 1200;
   s.position_p = 300;
@@ -338,7 +378,10 @@ const StartupField kStartupFields[] = {
     {"open_loop_current_ma", &StartupSettings::open_loop_current_ma, 0, 1e6},
     {"commutation", &StartupSettings::commutation},
     {"position_sensor", &StartupSettings::position_sensor},
+    {"hall_polarity_inverted", &StartupSettings::hall_polarity_inverted},
+    {"hall_direction_reversed", &StartupSettings::hall_direction_reversed},
     {"hall_interpolation", &StartupSettings::hall_interpolation},
+    {"encoder_direction_reversed", &StartupSettings::encoder_direction_reversed},
     {"encoder_alignment", &StartupSettings::encoder_alignment},
     {"brake_chopper_voltage_v", &StartupSettings::brake_chopper_voltage_v, 0.0, 1000.0},
     {"current_p", &StartupSettings::current_p, 0, 2147483647.0},
@@ -516,10 +559,13 @@ void read_axis_parameters(Reader& top, const AxisParameterCheck& check, std::vec
 
 }  // namespace
 
-std::vector<std::string_view> motor_preset_names() { return {"default-24v", "large-48v", "dc-24v"}; }
+std::vector<std::string_view> motor_preset_names() {
+  return {"default-24v", "qbl4208-61-04-013", "large-48v", "dc-24v"};
+}
 
 std::optional<MotorDescription> motor_preset(std::string_view name) {
   if (name == "default-24v") return default_24v();
+  if (name == "qbl4208-61-04-013") return qbl4208_61_04_013();
   if (name == "large-48v") return large_48v();
   if (name == "dc-24v") return dc_24v();
   return std::nullopt;

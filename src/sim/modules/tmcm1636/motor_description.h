@@ -45,6 +45,11 @@ struct StartupSettings {
   std::optional<CommutationSensor> commutation;
   std::optional<PositionSensor> position_sensor;
   std::optional<bool> hall_interpolation;       // the hall angle interpolated between edges
+  // Settings that undo how the sensors are wired (hall.inverted, hall.reversed, abn.reversed):
+  // true sets the firmware's hall polarity, hall direction or encoder direction to 1.
+  std::optional<bool> hall_polarity_inverted;
+  std::optional<bool> hall_direction_reversed;
+  std::optional<bool> encoder_direction_reversed;
   std::optional<EncoderAlignment> encoder_alignment;
   std::optional<double> brake_chopper_voltage_v;  // bus voltage above which the chopper dumps energy
   // Gains of the drive's regulator cascade, in the TMCM-1636's integer scaling (docs/tmcm-1636-servo.md,
@@ -120,7 +125,7 @@ struct MotorDescription {
   }
 };
 
-// "default-24v", "large-48v", "dc-24v".
+// "default-24v", "qbl4208-61-04-013", "large-48v", "dc-24v".
 std::vector<std::string_view> motor_preset_names();
 std::optional<MotorDescription> motor_preset(std::string_view name);
 
