@@ -16,6 +16,8 @@ namespace {
 // While the process is out of descriptors, accepting is retried this much later instead of
 // spinning on a listening socket that stays readable.
 constexpr uint64_t kAcceptRetryUs = 100'000;
+// How long a full server keeps new clients waiting in the backlog for a slot before it refuses them.
+constexpr uint64_t kRefuseAfterUs = 100'000;
 // Sent output is dropped from the front of the buffer once this much has piled up.
 constexpr size_t kCompactOutputBytes = 64 * 1024;
 
@@ -165,13 +167,17 @@ TcpConnection* TcpConnectionServer::find(uint64_t id) {
   return found == connections_.end() ? nullptr : found->second.get();
 }
 
-void TcpConnectionServer::accept_clients(bool after_other_callbacks) {
+void TcpConnectionServer::accept_clients(WhenFull when_full) {
   for (;;) {
-    if (connections_.size() >= config_.max_clients && !after_other_callbacks) {
+    if (connections_.size() >= config_.max_clients && when_full == WhenFull::kLookAgainAfterThisIteration) {
       std::weak_ptr<bool> alive = lifetime_;
       loop_.defer([this, alive] {
-        if (!alive.expired()) accept_clients(true);
+        if (!alive.expired()) accept_clients(WhenFull::kPauseUntilASlotFrees);
       });
+      return;
+    }
+    if (connections_.size() >= config_.max_clients && when_full == WhenFull::kPauseUntilASlotFrees) {
+      pause_accepting_until_a_slot_frees();
       return;
     }
     sockaddr_storage address{};
@@ -212,7 +218,25 @@ void TcpConnectionServer::accept_clients(bool after_other_callbacks) {
   }
 }
 
+void TcpConnectionServer::pause_accepting_until_a_slot_frees() {
+  // New clients wait in the listen backlog meanwhile.
+  paused_while_full_ = true;
+  loop_.set_events(listen_fd_, 0);
+  std::weak_ptr<bool> alive = lifetime_;
+  loop_.add_timer_after(kRefuseAfterUs, [this, alive] {
+    if (alive.expired() || !paused_while_full_) return;
+    resume_accepting();
+    accept_clients(WhenFull::kRefuse);  // still full: the waiting clients are refused
+  });
+}
+
+void TcpConnectionServer::resume_accepting() {
+  paused_while_full_ = false;
+  loop_.set_events(listen_fd_, POLLIN);
+}
+
 void TcpConnectionServer::remove(TcpConnection& connection, const std::string& reason) {
+  if (paused_while_full_) resume_accepting();  // the next poll takes a waiting client
   loop_.unwatch(connection.fd_);
   connection.session_->on_close();
   log_("motwin: " + config_.kind + " client " + connection.peer_ + " disconnected (" + reason + ")");

@@ -123,9 +123,18 @@ class TcpConnectionServer {
  private:
   friend class TcpConnection;
   TcpConnectionServer(EventLoop& loop, int listen_fd, Config config, SessionFactory factory, LogSink log);
-  // `after_other_callbacks`: a second look at a full server, once the connections that closed
-  // in the same loop iteration have been removed.
-  void accept_clients(bool after_other_callbacks = false);
+  // What a full server does with the next client. A client is refused only when the server is
+  // still full after two more looks: once the connections that closed in the same loop iteration
+  // are removed, then once those it has just accepted were polled (a burst of clients that
+  // connect and hang up at once, accepted together on a loaded machine, holds slots until then).
+  enum class WhenFull {
+    kLookAgainAfterThisIteration,
+    kPauseUntilASlotFrees,  // stop accepting until a client goes, at most kRefuseAfterUs
+    kRefuse,
+  };
+  void accept_clients(WhenFull when_full = WhenFull::kLookAgainAfterThisIteration);
+  void pause_accepting_until_a_slot_frees();
+  void resume_accepting();
   void remove(TcpConnection& connection, const std::string& reason);
 
   EventLoop& loop_;
@@ -134,6 +143,7 @@ class TcpConnectionServer {
   SessionFactory factory_;
   LogSink log_;
   uint64_t next_connection_id_ = 1;
+  bool paused_while_full_ = false;
   std::map<uint64_t, std::shared_ptr<TcpConnection>> connections_;
   std::shared_ptr<bool> lifetime_ = std::make_shared<bool>(true);
 };

@@ -288,6 +288,26 @@ TEST_F(TcpServerTest, clients_beyond_the_limit_are_refused_and_a_freed_slot_is_t
   EXPECT_EQ(receive(*clients.back(), 9), reply(100, kGap, kDefaultMaxVelocity));
 }
 
+// Clients that connect and hang up at once, all accepted in one loop iteration on a loaded
+// machine, fill the last slots before their hang-ups are polled; a client behind them waits in
+// the backlog until they are gone instead of being refused.
+TEST_F(TcpServerTest, a_newcomer_behind_clients_that_hung_up_waits_for_their_slots) {
+  std::vector<std::unique_ptr<TcpTestClient>> clients;
+  constexpr size_t kHangingUp = 4;
+  for (size_t i = 0; i < TmclTcpServer::kMaxClients - kHangingUp; ++i) {
+    clients.push_back(std::make_unique<TcpTestClient>(server_->local_port()));
+    pump_until([&] { return server_->client_count() == i + 1; });
+  }
+  for (size_t i = 0; i < kHangingUp; ++i) {
+    TcpTestClient gone(server_->local_port());  // in the backlog, closed before the loop runs
+  }
+  TcpTestClient newcomer(server_->local_port());
+  newcomer.send(request(kGap, 43, 0, 0));
+  EXPECT_EQ(receive(newcomer, 9), reply(100, kGap, kDefaultMaxVelocity));
+  EXPECT_EQ(server_->client_count(), TmclTcpServer::kMaxClients - kHangingUp + 1);
+  for (const std::string& line : log_) EXPECT_EQ(line.find("refusing"), std::string::npos) << line;
+}
+
 TEST_F(TcpServerTest, shutting_the_server_down_closes_its_clients) {
   TcpTestClient client(server_->local_port());
   pump_until([this] { return server_->client_count() == 1; });
