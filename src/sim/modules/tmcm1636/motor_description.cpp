@@ -69,7 +69,7 @@ MotorDescription default_24v() {
 // AP 101 = 1, so here the hall levels are inverted and the encoder counts down for forward
 // rotation (docs/tmcm-1636-servo.md "Presets").
 MotorDescription qbl4208_61_04_013() {
-  MotorDescription m;
+  MotorDescription m = default_24v();  // the same 42 mm motor; what its datasheet and wiring change
   m.name = "qbl4208-61-04-013";
   m.source =
       "Trinamic QBL4208-61-04-013 (-1024-AT in the older order code), datasheet QBL4208-x-1k "
@@ -77,30 +77,13 @@ MotorDescription qbl4208_61_04_013() {
       "1.2 mH, torque constant 0.036 N m/A, rotor inertia 48 g cm^2; hall sensors and a 4096-count "
       "ABN encoder wired as on Trinamic's setup (hall polarity and encoder direction 1); friction "
       "chosen for a no-load current of about 0.3 A at 4000 rpm";
-  m.kind = MotorKind::kBldc;
-  m.pole_pairs = 4;
   m.resistance_ohm = 0.36;  // star equivalent of the delta winding: half the line-to-line value
-  m.inductance_d_h = 0.6e-3;
-  m.inductance_q_h = 0.6e-3;
   m.flux_linkage_wb = 0.036 / (1.5 * 4);
-  m.rotor_inertia_kgm2 = 4.8e-6;
-  m.viscous_friction_nm_s = 1.5e-5;
-  m.coulomb_friction_nm = 0.004;
-  m.initial_angle_deg = 40.0;
   m.hall.inverted = true;
-  m.abn = {true, 4096, 200.0, true};
-  m.supply = {24.0, 0.1, 470e-6, 10.0, false};
-  StartupSettings s = bldc_startup();
-  s.hall_polarity_inverted = true;  // AP 90 = 1, as the examples set it
-  s.encoder_direction_reversed = true;  // AP 101 = 1
-  s.max_current_ma = 2000;
-  s.open_loop_current_ma = 1000;
-  s.current_p = 461;  // current loop at 3000 rad/s: P = L w, I = R w (docs/tmcm-1636-servo.md)
-  s.current_i = 3539;
-  s.velocity_p = 1200;
-  s.velocity_i = 1200;
-  s.position_p = 300;
-  m.startup = s;
+  m.abn.reversed = true;
+  m.startup->hall_polarity_inverted = true;  // AP 90 = 1, as the examples set it
+  m.startup->encoder_direction_reversed = true;  // AP 101 = 1
+  m.startup->current_i = 3539;  // I = R w with the datasheet's resistance
   return m;
 }
 
