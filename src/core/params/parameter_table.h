@@ -109,4 +109,65 @@ constexpr auto join_rows(const Parts&... parts) {
   return rows;
 }
 
+// How a generation of a module's firmware changes the rows of another (TMCM-1636 1.13 from
+// 1.09): rows it no longer has, rows that keep their number and text but reach the module
+// another way, rows it adds.
+template <class Owner>
+struct ReboundRow {
+  uint16_t number;
+  Binding<Owner> binding;
+};
+
+// Deliberately not constexpr: reaching it during constant evaluation is a compile error.
+void revised_row_not_in_base();
+
+// `base` without the numbers in `removed`, with the bindings of `rebound`, plus `added`, sorted by
+// number (sorted_table() then checks that no number comes twice). Every removed or rebound number
+// must be a row of `base`.
+template <class Owner, size_t kResult>
+consteval std::array<ParameterRow<Owner>, kResult> revised_rows(std::span<const ParameterRow<Owner>> base,
+                                                                 std::span<const uint16_t> removed,
+                                                                 std::span<const ReboundRow<Owner>> rebound,
+                                                                 std::span<const ParameterRow<Owner>> added) {
+  const auto in_base = [&](uint16_t number) {
+    for (const ParameterRow<Owner>& row : base) {
+      if (row.info.number == number) return true;
+    }
+    return false;
+  };
+  for (uint16_t number : removed) {
+    if (!in_base(number)) revised_row_not_in_base();
+  }
+  for (const ReboundRow<Owner>& row : rebound) {
+    if (!in_base(row.number)) revised_row_not_in_base();
+  }
+  std::array<ParameterRow<Owner>, kResult> rows{};
+  size_t next = 0;
+  for (const ParameterRow<Owner>& row : base) {
+    bool dropped = false;
+    for (uint16_t number : removed) dropped = dropped || number == row.info.number;
+    if (dropped) continue;
+    if (next == kResult) revised_row_not_in_base();  // kResult too small
+    rows[next] = row;
+    for (const ReboundRow<Owner>& change : rebound) {
+      if (change.number == row.info.number) rows[next].binding = change.binding;
+    }
+    ++next;
+  }
+  for (const ParameterRow<Owner>& row : added) {
+    if (next == kResult) revised_row_not_in_base();
+    rows[next++] = row;
+  }
+  if (next != kResult) revised_row_not_in_base();  // kResult too large
+  // Insertion sort by number.
+  for (size_t i = 1; i < kResult; ++i) {
+    for (size_t j = i; j > 0 && rows[j - 1].info.number > rows[j].info.number; --j) {
+      const ParameterRow<Owner> swapped = rows[j];
+      rows[j] = rows[j - 1];
+      rows[j - 1] = swapped;
+    }
+  }
+  return rows;
+}
+
 }  // namespace motwin::params

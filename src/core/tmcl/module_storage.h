@@ -3,6 +3,8 @@
 // (A) globals, the power-up restore from the EEPROM image, the factory image and command 137.
 // A CRTP base: `Derived` (Tmcm1636, Tmcm142) provides
 //   - static axis_parameters(), global_parameters() (params::ParameterTable<Derived>),
+//     (a module whose axis rows depend on its firmware generation hides axis_table(), the
+//     table of the running instance; the default is axis_parameters()),
 //   - static constexpr kNvmLayout and kMotorCount,
 //   - void clear_ram_state()        power-up: config and state structs back to their defaults,
 // (the TMCL module base, tmcl_module.h, provides all but the tables) and may hide these defaults:
@@ -42,10 +44,14 @@ class ModuleStorage : public TmclDevice {
   // Writes the factory image: every stored parameter at its default, user variables and
   // coordinates 0, program memory full of STOP (so autostart of an empty module stops at once).
   static void format_factory_image(uint8_t* image, size_t size) {
+    format_factory_image(image, size, Derived::axis_parameters());
+  }
+  // The same for the axis rows of one firmware generation of the module.
+  static void format_factory_image(uint8_t* image, size_t size, const params::ParameterTable<Derived>& axis_table) {
     constexpr NvmLayout layout = Derived::kNvmLayout;
     std::memset(image, 0, size);
     if (size < layout.total_size) return;
-    for (const auto& row : Derived::axis_parameters().rows()) {
+    for (const auto& row : axis_table.rows()) {
       if (!is_stored_parameter(row.info)) continue;
       for (uint8_t motor = 0; motor < Derived::kMotorCount; ++motor) {
         put_le32(image + layout.axis_parameter(motor, static_cast<uint8_t>(row.info.number)),
@@ -69,21 +75,21 @@ class ModuleStorage : public TmclDevice {
 
   // TmclDevice: parameters.
   Status set_axis_parameter(uint8_t number, uint8_t motor, int32_t value) override {
-    return Derived::axis_parameters().write(derived(), motor, number, value);
+    return derived().axis_table().write(derived(), motor, number, value);
   }
 
   Status get_axis_parameter(uint8_t number, uint8_t motor, int32_t& value) override {
-    return Derived::axis_parameters().read(derived(), motor, number, value);
+    return derived().axis_table().read(derived(), motor, number, value);
   }
 
   Status store_axis_parameter(uint8_t number, uint8_t motor) override {
-    const auto* row = Derived::axis_parameters().find(number);
+    const auto* row = derived().axis_table().find(number);
     if (row == nullptr || !params::has(row->info.access, params::Access::kEeprom)) return Status::kWrongType;
     return store_parameter(Derived::kNvmLayout.axis_parameter(motor, number), row->binding.get(derived(), motor));
   }
 
   Status restore_axis_parameter(uint8_t number, uint8_t motor) override {
-    const auto* row = Derived::axis_parameters().find(number);
+    const auto* row = derived().axis_table().find(number);
     if (row == nullptr || !params::has(row->info.access, params::Access::kEeprom)) return Status::kWrongType;
     const int32_t value = stored_value(Derived::kNvmLayout.axis_parameter(motor, number));
     if (!params::in_range(row->info, value)) return Status::kInvalidValue;
@@ -157,7 +163,7 @@ class ModuleStorage : public TmclDevice {
     user_variables_.fill(0);
     if (nvm_.size() < layout.total_size) return;
     derived().before_axis_restore();
-    for (const auto& row : Derived::axis_parameters().rows()) {
+    for (const auto& row : derived().axis_table().rows()) {
       if (!is_stored_parameter(row.info)) continue;
       for (uint8_t motor = 0; motor < Derived::kMotorCount; ++motor) {
         const int32_t value = stored_value(layout.axis_parameter(motor, static_cast<uint8_t>(row.info.number)));
@@ -181,11 +187,12 @@ class ModuleStorage : public TmclDevice {
   // powers the module up afterwards.
   void restore_factory_defaults() override {
     static uint8_t image[Derived::kNvmLayout.total_size];
-    format_factory_image(image, sizeof image);
+    format_factory_image(image, sizeof image, derived().axis_table());
     last_store_failed_ = !nvm_.write(0, image, Derived::kNvmLayout.program_offset);
   }
 
   // Default hooks; Derived hides the ones it needs.
+  const auto& axis_table() const { return Derived::axis_parameters(); }
   void before_axis_restore() {}
   void after_axis_restore() {}
   void after_restore() {}

@@ -123,7 +123,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   }
   TmclRuntime& runtime() override { return runtime_; }
   Status rotate(uint8_t motor, int32_t velocity) override {
-    return Derived::axis_parameters().write(derived(), motor, kFacts.motion.target_velocity, velocity);
+    return derived().axis_table().write(derived(), motor, kFacts.motion.target_velocity, velocity);
   }
   // MST: velocity mode with target 0, stopping with the ramp, as ROR 0.
   Status stop(uint8_t motor) override { return rotate(motor, 0); }
@@ -134,7 +134,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
       case move_type::kAbsolute:
         return move_to(motor, value);
       case move_type::kRelative:
-        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(axis_.actual_position()) +
+        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(derived().host_actual_position()) +
                                                    static_cast<uint32_t>(value)));
       default:
         return Status::kWrongType;
@@ -183,6 +183,9 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
     set_tick_timer_ms(0);
   }
   bool skip_user_variable_restore() const { return globals_.skip_user_variable_restore != 0; }
+  // The actual position as the host reads it, which MVP REL adds to; a module whose parameter
+  // rows transform it (the TMCM-1636's motor direction, AP 13 of firmware 1.13) hides this.
+  int32_t host_actual_position() const { return axis_.actual_position(); }
 
  protected:
   // Does not touch `nvm` beyond reading it: call engine().power_up() to start.
@@ -194,7 +197,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
 
   // MVP to an absolute position: a write of the target position parameter.
   Status move_to(uint8_t motor, int32_t position) {
-    return Derived::axis_parameters().write(derived(), motor, kFacts.motion.target_position, position);
+    return derived().axis_table().write(derived(), motor, kFacts.motion.target_position, position);
   }
 
  private:

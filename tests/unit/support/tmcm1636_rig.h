@@ -35,11 +35,13 @@ using Tmcm1636Nvm = board::RamNonVolatileMemory<Tmcm1636::kNvmLayout.total_size>
 struct Tmcm1636Rig {
   Tmcm1636Nvm nvm;
   ScriptedTmcm1636Io io;
-  Tmcm1636 module{nvm, io};
+  Tmcm1636 module;
   tmcl::TmclEngine& engine{module.engine()};
 
-  Tmcm1636Rig() {
-    Tmcm1636::format_factory_image(nvm.mutable_data(), nvm.size());
+  // A factory image of the generation's rows, as `motwin serve --firmware` makes it.
+  explicit Tmcm1636Rig(modules::tmcm1636::Firmware firmware = modules::tmcm1636::Firmware::kV109)
+      : module(nvm, io, firmware) {
+    Tmcm1636::format_factory_image(nvm.mutable_data(), nvm.size(), Tmcm1636::axis_parameters(firmware));
     engine.power_up();
   }
 

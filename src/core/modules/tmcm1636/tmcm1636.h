@@ -1,6 +1,9 @@
-// The TMCM-1636 module profile (firmware 1636V109): its parameter tables, its axis and its
-// I/O on the TMCL module base (core/tmcl/tmcl_module.h), behind the TmclDevice interface the
-// TMCL engine dispatches into.
+// The TMCM-1636 module profile: its parameter tables, its axis and its I/O on the TMCL module
+// base (core/tmcl/tmcl_module.h), behind the TmclDevice interface the TMCL engine dispatches
+// into. Two firmware generations (docs/tmcm-1636.md "Firmware generations"): 1636V109, the
+// manual Motwin follows and the default, and 1636V113, the later revision PyTrinamic's TMCM1636
+// class targets. A generation is const configuration chosen at construction: its identity and
+// its axis-parameter rows; the code is the same.
 #pragma once
 
 #include <array>
@@ -41,6 +44,11 @@ inline constexpr size_t kUserVariableCount = tmcl::kUserVariableCount;  // bank 
 inline constexpr size_t kStorableUserVariables = 56;  // 0..55 (manual 4.2)
 inline constexpr size_t kProgramCapacity = 2048;      // instructions
 
+// The firmware generations, oldest first.
+enum class Firmware : uint8_t { kV109, kV113 };
+
+inline constexpr tmcl::FirmwareIdentity kIdentityV113{1636, 1, 13, "1636V113"};
+
 inline constexpr tmcl::ModuleFacts kFacts{
     .name = "tmcm-1636",
     .identity = {1636, 1, 9, "1636V109"},
@@ -57,17 +65,38 @@ inline constexpr tmcl::ModuleFacts kFacts{
 // the module adds its tables and the tick of its axis.
 class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts> {
  public:
-  Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io) : TmclModule(nvm, io) {}
+  Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io, Firmware firmware = Firmware::kV109)
+      : TmclModule(nvm, io), firmware_(firmware), axis_table_(&axis_parameters(firmware)) {}
 
-  static const Table& axis_parameters();
-  static const Table& global_parameters();  // bank 0
-  // format_factory_image(image, size): tmcl::ModuleStorage.
+  // Firmware 1.09's axis parameters (manual table 11), and those of a generation.
+  static const Table& axis_parameters() { return axis_parameters(Firmware::kV109); }
+  static const Table& axis_parameters(Firmware firmware);
+  static const Table& global_parameters();  // bank 0, the same in every generation
+  static const tmcl::FirmwareIdentity& identity_of(Firmware firmware) {
+    return firmware == Firmware::kV113 ? kIdentityV113 : kIdentity;
+  }
+  // format_factory_image(image, size[, axis table]): tmcl::ModuleStorage.
+
+  Firmware firmware() const { return firmware_; }
+  // tmcl::ModuleStorage hook: the rows of this instance's generation.
+  const Table& axis_table() const { return *axis_table_; }
+  // TmclDevice: command 136 of this generation.
+  const tmcl::FirmwareIdentity& identity() const override { return identity_of(firmware_); }
+  // tmcl::TmclModule hook: MVP REL adds to the position as AP 52 reads it (AP 13 inverts it).
+  int32_t host_actual_position() const {
+    const int32_t position = axis().actual_position();
+    return axis().config.motor_direction != 0 ? static_cast<int32_t>(0u - static_cast<uint32_t>(position)) : position;
+  }
 
   // tmcl::TmclModule hook: one 50 µs control tick of the axis.
   void tick_axis() { axis().tick(io(), static_cast<double>(kControlTickUs) * 1e-6); }
 
   // tmcl::ModuleStorage hook.
   void after_axis_restore() { axis().finish_restore(); }  // later writes are host commands
+
+ private:
+  Firmware firmware_;
+  const Table* axis_table_;
 };
 
 }  // namespace motwin::modules::tmcm1636

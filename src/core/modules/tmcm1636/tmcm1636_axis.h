@@ -30,6 +30,7 @@ enum class CommutationMode : int32_t { kDisabled = 0, kOpenLoop = 1, kDigitalHal
 // AP 25: the source of the position counter (AP 52).
 enum class PositionCommutationMode : int32_t { kSameAsCommutation = 0, kAbnEncoder = 1, kAbsoluteEncoder = 2 };
 // AP 102: how the ABN encoder initialisation finds the commutation offset.
+enum class VelocitySensorSelection : int32_t { kSameAsCommutation = 0, kAbnEncoder = 1, kAbsoluteEncoder = 2 };
 enum class EncoderInitMode : int32_t { kEstimateOffset = 0, kNChannel = 1, kUseHall = 2 };
 // AP 160.
 enum class AbsoluteEncoderType : int32_t { kNone = 0, kAmt20 = 1, kAmt23 = 2 };
@@ -50,14 +51,19 @@ struct AxisConfig {
   int32_t motor_pole_pairs = 4;              // AP 10
   int32_t max_current_ma = 2000;             // AP 11
   int32_t open_loop_current_ma = 2000;       // AP 12
+  // Firmware 1.13 only (docs/tmcm-1636.md "Firmware generations"); 1.09 has no row for them, so
+  // they keep these defaults there.
+  int32_t motor_direction = 0;               // AP 13: 1 = host frame is the motor's inverted
   MotorType motor_type = MotorType::kNone;   // AP 14
   CommutationMode commutation_mode = CommutationMode::kDisabled;  // AP 15
   PositionCommutationMode position_commutation_mode = PositionCommutationMode::kSameAsCommutation;  // AP 25
+  VelocitySensorSelection velocity_sensor_selection = VelocitySensorSelection::kSameAsCommutation;  // AP 26 (1.13), stored only
   int32_t max_velocity_rpm = 4000;           // AP 43
   int32_t acceleration_rpm_per_s = 2000;     // AP 44
   int32_t velocity_ramp_enabled = 1;         // AP 45
   int32_t position_reached_distance = 5;     // AP 53, position counts
   int32_t position_reached_velocity_rpm = 500;  // AP 54
+  int32_t position_scaler = 65536;           // AP 56 (1.13), stored only
   motion::PiConfig current_pi;               // AP 70 (P), 71 (I): torque and flux regulators
   motion::PiConfig velocity_pi;              // AP 72, 73
   motion::PiConfig position_pi;              // AP 74 (P only; I stays 0)
@@ -86,6 +92,9 @@ struct AxisConfig {
   AbsoluteEncoderInit absolute_encoder_init = AbsoluteEncoderInit::kEstimateOffset;  // AP 161
   int32_t absolute_encoder_direction = 0;    // AP 162
   int32_t absolute_encoder_offset = 0;       // AP 163, 65536 per mechanical revolution
+  int32_t absolute_encoder_data_length = 16;     // AP 165 (1.13), bits per transfer, stored only
+  int32_t absolute_encoder_position_start = 0;   // AP 166 (1.13), first position bit, stored only
+  int32_t absolute_encoder_position_length = 16; // AP 167 (1.13), position bits, stored only
   int32_t reference_switch_enable = 0;       // AP 209: bit 0 right, bit 1 left
   int32_t reference_switch_polarity = 0;     // AP 210: bit 0 right, 1 left, 2 home; 1 = high active
 };
@@ -204,6 +213,16 @@ class Tmcm1636Axis {
   bool position_reached() const { return state.position_reached != 0; }
   const motion::TrapezoidRamp& ramp() const { return ramp_; }
   bool encoder_initialised() const { return servo_.abn_initialised; }
+  // AP 94 (1.13): the hall inputs' electrical levels, bit 0 H1, bit 1 H2, bit 2 H3 (0 without a
+  // power stage: the ideal motor has no sensors).
+  int32_t hall_inputs() const { return power_stage_ != nullptr ? power_stage_->feedback.hall & 7 : 0; }
+  // AP 109 (1.13): bit 0 A, bit 1 B from the quadrature counter's phase (the board gives the
+  // counter, not the levels); bit 2 N is 0 (the board latches N pulses, it gives no level).
+  int32_t encoder_inputs() const {
+    if (power_stage_ == nullptr) return 0;
+    static constexpr int32_t kQuadrature[4] = {0b00, 0b01, 0b11, 0b10};
+    return kQuadrature[static_cast<uint32_t>(power_stage_->feedback.abn_count) & 3u];
+  }
 
   // rpm <-> position counts per second, with AP 100 counts per revolution.
   double counts_per_second(double velocity_rpm) const;

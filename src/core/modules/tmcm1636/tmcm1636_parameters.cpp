@@ -2,6 +2,7 @@
 // table 13 (global parameters, bank 0), bound to the module's config and state fields.
 // Ranges whose separators the manual lost ("060000") are read as "0...60000".
 #include <cmath>
+#include <iterator>
 
 #include "core/modules/tmcm1636/tmcm1636.h"
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
@@ -44,11 +45,37 @@ constexpr Binding<Tmcm1636> kDriverTemperature{
     },
     nullptr};
 
+// Firmware 1.13's motor direction (AP 13): with AP 13 = 1 the host's frame is the motor's
+// inverted, so a binding of a signed motion value (target and actual torque, velocity, position)
+// changes the sign on its way in and out. Negation wraps at 32 bits like the position counter.
+int32_t directed(const Tmcm1636& m, int32_t value) {
+  return m.axis().config.motor_direction != 0 ? static_cast<int32_t>(0u - static_cast<uint32_t>(value)) : value;
+}
+
+template <const Binding<Tmcm1636>& kMotorFrame>
+constexpr Binding<Tmcm1636> host_frame() {
+  Binding<Tmcm1636> binding;
+  binding.get = [](Tmcm1636& m, uint8_t axis) { return directed(m, kMotorFrame.get(m, axis)); };
+  if constexpr (kMotorFrame.set != nullptr) {
+    binding.set = [](Tmcm1636& m, uint8_t axis, int32_t value) { return kMotorFrame.set(m, axis, directed(m, value)); };
+  }
+  return binding;
+}
+
 }  // namespace
 
 // Manual table 11. The bindings (config_field, state_value, axis_command ...) are those of
 // tmcl::ModuleRows (core/tmcl/module_rows.h).
-const Tmcm1636::Table& Tmcm1636::axis_parameters() {
+const Tmcm1636::Table& Tmcm1636::axis_parameters(Firmware firmware) {
+  // The motion values AP 13 of firmware 1.13 inverts (host_frame above).
+  static constexpr Binding kTargetTorque = axis_command<&AxisState::target_torque_ma, &Tmcm1636Axis::set_target_torque>();
+  static constexpr Binding kActualTorque = state_value<&AxisState::actual_torque_ma>();
+  static constexpr Binding kTargetVelocity = axis_command<&AxisState::target_velocity_rpm, &Tmcm1636Axis::set_target_velocity>();
+  static constexpr Binding kRampVelocity = state_value<&AxisState::ramp_velocity_rpm>();
+  static constexpr Binding kActualVelocity = state_value<&AxisState::actual_velocity_rpm>();
+  static constexpr Binding kTargetPosition = axis_command<&Tmcm1636Axis::target_position, &Tmcm1636Axis::set_target_position>();
+  static constexpr Binding kRampPosition = axis_value<&Tmcm1636Axis::ramp_position>();
+  static constexpr Binding kActualPosition = axis_command<&AxisState::actual_position, &Tmcm1636Axis::set_actual_position>();
   // clang-format off
   static constexpr Row kRows[] = {
     {{0, "adc_I0_raw", 0, 65535, 32767, access("R"), Unit::kAdcCount, "Raw ADC measurement of the phase A shunt"}, state_value<&AxisState::adc_phase_a_raw>()},
@@ -70,19 +97,19 @@ const Tmcm1636::Table& Tmcm1636::axis_parameters() {
     {{18, "digital hall commutation angle", -32768, 32767, 0, access("R"), Unit::kNone, "Actual digital hall angle"}, state_value<&AxisState::hall_angle>()},
     {{19, "absolute encoder commutation angle", -32768, 32767, 0, access("R"), Unit::kNone, "Actual absolute encoder angle"}, state_value<&AxisState::absolute_encoder_angle>()},
     {{25, "commutation mode position", 0, 2, 0, access("RWEX"), Unit::kNone, "Position source: 0 same as FOC, 1 ABN encoder, 2 absolute encoder"}, config_field<&AxisConfig::position_commutation_mode>()},
-    {{30, "target torque", -60000, 60000, 0, access("RW"), Unit::kMilliampere, "Target current; writing it selects current regulation"}, axis_command<&AxisState::target_torque_ma, &Tmcm1636Axis::set_target_torque>()},
-    {{31, "actual torque", kMin32, kMax32, 0, access("R"), Unit::kMilliampere, "Actual motor current"}, state_value<&AxisState::actual_torque_ma>()},
+    {{30, "target torque", -60000, 60000, 0, access("RW"), Unit::kMilliampere, "Target current; writing it selects current regulation"}, kTargetTorque},
+    {{31, "actual torque", kMin32, kMax32, 0, access("R"), Unit::kMilliampere, "Actual motor current"}, kActualTorque},
     {{32, "target flux", -60000, 60000, 0, access("RW"), Unit::kMilliampere, "Target flux; writing it selects current regulation"}, axis_command<&AxisState::target_flux_ma, &Tmcm1636Axis::set_target_flux>()},
     {{33, "actual flux", kMin32, kMax32, 0, access("R"), Unit::kMilliampere, "Actual motor flux"}, state_value<&AxisState::actual_flux_ma>()},
-    {{40, "target velocity", -200000, 200000, 0, access("RW"), Unit::kRpm, "Target velocity; writing it selects velocity mode"}, axis_command<&AxisState::target_velocity_rpm, &Tmcm1636Axis::set_target_velocity>()},
-    {{41, "ramp velocity", kMin32, kMax32, 0, access("R"), Unit::kRpm, "Velocity of the ramp generator"}, state_value<&AxisState::ramp_velocity_rpm>()},
-    {{42, "actual velocity", kMin32, kMax32, 0, access("R"), Unit::kRpm, "Actual motor velocity"}, state_value<&AxisState::actual_velocity_rpm>()},
+    {{40, "target velocity", -200000, 200000, 0, access("RW"), Unit::kRpm, "Target velocity; writing it selects velocity mode"}, kTargetVelocity},
+    {{41, "ramp velocity", kMin32, kMax32, 0, access("R"), Unit::kRpm, "Velocity of the ramp generator"}, kRampVelocity},
+    {{42, "actual velocity", kMin32, kMax32, 0, access("R"), Unit::kRpm, "Actual motor velocity"}, kActualVelocity},
     {{43, "max velocity", 0, 200000, 4000, access("RWEX"), Unit::kRpm, "Maximum velocity in velocity and position mode"}, config_field<&AxisConfig::max_velocity_rpm>()},
     {{44, "acceleration", 0, 100000, 2000, access("RWEX"), Unit::kRpmPerSecond, "Acceleration of the velocity ramp (ROR, ROL, MVP)"}, config_field<&AxisConfig::acceleration_rpm_per_s>()},
     {{45, "enable velocity ramp", 0, 1, 1, access("RWEX"), Unit::kNone, "1 ramp generator on, 0 off"}, config_field<&AxisConfig::velocity_ramp_enabled>()},
-    {{50, "target position", kMin32, kMax32, 0, access("RW"), Unit::kPositionCount, "Target position; writing it selects position mode"}, axis_command<&Tmcm1636Axis::target_position, &Tmcm1636Axis::set_target_position>()},
-    {{51, "ramp position", kMin32, kMax32, 0, access("R"), Unit::kPositionCount, "Position of the ramp generator"}, axis_value<&Tmcm1636Axis::ramp_position>()},
-    {{52, "actual position", kMin32, kMax32, 0, access("RW"), Unit::kPositionCount, "Actual position counter"}, axis_command<&AxisState::actual_position, &Tmcm1636Axis::set_actual_position>()},
+    {{50, "target position", kMin32, kMax32, 0, access("RW"), Unit::kPositionCount, "Target position; writing it selects position mode"}, kTargetPosition},
+    {{51, "ramp position", kMin32, kMax32, 0, access("R"), Unit::kPositionCount, "Position of the ramp generator"}, kRampPosition},
+    {{52, "actual position", kMin32, kMax32, 0, access("RW"), Unit::kPositionCount, "Actual position counter"}, kActualPosition},
     {{53, "position reached distance", 0, 100000, 5, access("RWEX"), Unit::kPositionCount, "Largest distance at which the position reached flag is set"}, config_field<&AxisConfig::position_reached_distance>()},
     {{54, "position reached velocity", 0, 200000, 500, access("RWEX"), Unit::kRpm, "Largest velocity at which the position reached flag is set"}, config_field<&AxisConfig::position_reached_velocity_rpm>()},
     {{55, "position reached flag", 0, 1, 0, access("R"), Unit::kNone, "1 when actual position and velocity are within the target window"}, state_value<&AxisState::position_reached>()},
@@ -151,9 +178,32 @@ const Tmcm1636::Table& Tmcm1636::axis_parameters() {
     // Manual default column says 0, its description "enabled by default": we follow the text.
     {{255, "enable driver", 0, 1, 1, access("RW"), Unit::kNone, "0 driver disabled, 1 driver enabled"}, axis_command<&AxisState::driver_enabled, &Tmcm1636Axis::set_driver_enabled>()},
   };
+  // Firmware 1.13 (docs/tmcm-1636.md "Firmware generations"): numbers and names from
+  // PyTrinamic's TMCM1636 class, the default of AP 56 from the CANopen EDS Fw1.12; the other
+  // ranges and defaults are Motwin's choice ("inferred" in the doc), as is the meaning of AP 13.
+  static constexpr uint16_t kRemovedIn113[] = {7};  // dual shunt factor
+  static constexpr params::ReboundRow<Tmcm1636> kReboundIn113[] = {
+    {30, host_frame<kTargetTorque>()}, {31, host_frame<kActualTorque>()},
+    {40, host_frame<kTargetVelocity>()}, {41, host_frame<kRampVelocity>()}, {42, host_frame<kActualVelocity>()},
+    {50, host_frame<kTargetPosition>()}, {51, host_frame<kRampPosition>()}, {52, host_frame<kActualPosition>()},
+  };
+  static constexpr Row kAddedIn113[] = {
+    {{13, "motor direction", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted: the motor turns the other way; AP 30, 31, 40..42, 50..52 change sign between host and motor"}, config_field<&AxisConfig::motor_direction>()},
+    {{26, "velocity sensor selection", 0, 2, 0, access("RWEX"), Unit::kNone, "Velocity source: 0 same as commutation, 1 ABN encoder, 2 absolute encoder (stored only: the velocity comes from the position source, AP 25)"}, config_field<&AxisConfig::velocity_sensor_selection>()},
+    {{56, "position scaler", 1, 16777215, 65536, access("RWEX"), Unit::kNone, "Position counts per revolution for position units (stored only: positions stay in AP 100 counts)"}, config_field<&AxisConfig::position_scaler>()},
+    {{94, "hall sensor inputs", 0, 7, 0, access("R"), Unit::kNone, "Hall input levels: bit 0 H1, bit 1 H2, bit 2 H3"}, axis_value<&Tmcm1636Axis::hall_inputs>()},
+    {{109, "encoder inputs", 0, 7, 0, access("R"), Unit::kNone, "ABN encoder input levels: bit 0 A, bit 1 B, bit 2 N (N reads 0)"}, axis_value<&Tmcm1636Axis::encoder_inputs>()},
+    {{165, "absolute encoder data length", 1, 32, 16, access("RWEX"), Unit::kNone, "Bits per absolute encoder transfer (stored only)"}, config_field<&AxisConfig::absolute_encoder_data_length>()},
+    {{166, "absolute encoder position start", 0, 31, 0, access("RWEX"), Unit::kNone, "First position bit in the transfer (stored only)"}, config_field<&AxisConfig::absolute_encoder_position_start>()},
+    {{167, "absolute encoder position length", 1, 32, 16, access("RWEX"), Unit::kNone, "Number of position bits in the transfer (stored only)"}, config_field<&AxisConfig::absolute_encoder_position_length>()},
+  };
   // clang-format on
+  static constexpr size_t kRowsIn113 = std::size(kRows) - std::size(kRemovedIn113) + std::size(kAddedIn113);
+  static constexpr auto kRows113 =
+      params::revised_rows<Tmcm1636, kRowsIn113>(kRows, kRemovedIn113, kReboundIn113, kAddedIn113);
   static constexpr Table kTable = params::sorted_table<Tmcm1636>(kRows);
-  return kTable;
+  static constexpr Table kTable113 = params::sorted_table<Tmcm1636>(kRows113);
+  return firmware == Firmware::kV113 ? kTable113 : kTable;
 }
 
 // Bank 0 (table 13). Section 4.1: "parameters between 64 and 128 are automatically stored",
