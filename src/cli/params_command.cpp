@@ -17,6 +17,7 @@ namespace {
 struct ParamsOptions {
   std::string module_name;
   std::string format_name = "table";
+  std::string firmware;  // empty: the module's default generation
 };
 
 int run_params(const ParamsOptions& options) {
@@ -32,7 +33,9 @@ int run_params(const ParamsOptions& options) {
   if (!format) {
     return usage_error(fmt::format("unknown format '{}' (expected table, csv or markdown)", options.format_name));
   }
-  std::cout << tools::format_parameter_listing(module->listing(), *format);
+  const Result<host::ModuleParameterListing> listing = host::firmware_listing(*module, options.firmware);
+  if (!listing) return usage_error(listing.error());
+  std::cout << tools::format_parameter_listing(*listing, *format);
   return kExitSuccess;
 }
 
@@ -44,9 +47,14 @@ void add_params_command(CLI::App& app, int& exit_status) {
       "params", "List a module's axis parameters, global parameters and user variables, or its CANopen objects");
   command->add_option("--module", options->module_name, fmt::format("Module ({})", host::module_names()));
   command->add_option("--format", options->format_name, "table, csv or markdown")->capture_default_str();
+  command->add_option("--firmware", options->firmware,
+                      "The firmware generation whose parameters to list (motwin serve --help lists them); default: "
+                      "the module's first")
+      ->type_name("VERSION");
   command->footer(
       "Examples:\n"
       "  motwin params --module tmcm-1636\n"
+      "  motwin params --module tmcm-1636 --firmware 1.13\n"
       "  motwin params --module tmcm-1636 --format markdown > docs/tmcm-1636-parameters.md\n"
       "  motwin params --module tmcm-3216 --format csv\n"
       "\n"

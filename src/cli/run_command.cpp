@@ -61,6 +61,7 @@ struct RunOptions {
   std::vector<std::string> assignments;
   std::string scenario_path;
   std::string motor_model;
+  std::string firmware;  // empty: the module's default generation
   bool until_stopped = false;
 };
 
@@ -133,6 +134,8 @@ Result<RunPlan> check_options(const RunOptions& options) {
     return Error{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", options.module,
                              host::module_names(&host::has_tmcl))};
   }
+  const Result<const host::FirmwareGeneration*> firmware = host::find_firmware(*plan.descriptor, options.firmware);
+  if (!firmware) return Error{firmware.error()};
   const std::optional<uint64_t> duration_us = parse_duration_us(options.duration);
   if (!duration_us) {
     return Error{fmt::format("--for {}: expected a duration such as 10s, 500ms or 2.5s", options.duration)};
@@ -170,6 +173,7 @@ Result<std::unique_ptr<host::VirtualModule>> make_module_to_run(const RunOptions
                                                                 std::vector<host::InitialInput> initial_inputs) {
   host::ModuleOptions module_options;
   module_options.motor = options.motor_model;
+  module_options.firmware = options.firmware;
   module_options.initial_inputs = std::move(initial_inputs);
   if (options.state_dir != host::kNoStateDir) module_options.state_dir = options.state_dir;
   Result<std::unique_ptr<host::VirtualModule>> module = descriptor.make(module_options);
@@ -459,6 +463,8 @@ void add_run_command(CLI::App& app, int& exit_status) {
       ->type_name("FILE");
   command->add_option("--motor", options->motor_model, "The motor model, as motwin serve --motor")
       ->type_name("MODEL");
+  command->add_option("--firmware", options->firmware, "The firmware generation, as motwin serve --firmware")
+      ->type_name("VERSION");
   command->footer(
       "Examples:\n"
       "  motwin run program.tmc --for 10s --trace trace.csv\n"

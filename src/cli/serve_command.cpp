@@ -68,6 +68,7 @@ struct ServeArguments {
   std::vector<std::string> assignments;
   std::string scenario_path;
   std::string motor = "ideal";
+  std::string firmware;  // empty: the module's default generation
   std::vector<std::string> nodes;
   std::string can_bitrate = "1M";
   double can_stats_s = 0;
@@ -180,8 +181,9 @@ Result<std::optional<std::filesystem::path>> state_dir_of(const std::string& sta
 Result<void> check_node_options(const ServeArguments& arguments) {
   if (arguments.nodes.empty()) return {};
   if (!arguments.tcp_endpoints.empty() || !arguments.pty_link.empty() || !arguments.assignments.empty() ||
-      !arguments.scenario_path.empty() || arguments.node_id != 0 || arguments.motor != "ideal" || arguments.module_given) {
-    return Error{"--node cannot be combined with --module, --tmcl-tcp, --tmcl-pty, --set, --scenario, --motor or "
+      !arguments.scenario_path.empty() || arguments.node_id != 0 || arguments.motor != "ideal" || arguments.module_given ||
+      !arguments.firmware.empty()) {
+    return Error{"--node cannot be combined with --module, --firmware, --tmcl-tcp, --tmcl-pty, --set, --scenario, --motor or "
                  "--node-id (give per-node options: --node tmcm-3216:node-id=2)"};
   }
   return {};
@@ -193,6 +195,9 @@ Result<ModulePlan> check_module_arguments(const ServeArguments& arguments) {
   if (plan.descriptor == nullptr) {
     return Error{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
   }
+  const Result<const host::FirmwareGeneration*> firmware = host::find_firmware(*plan.descriptor, arguments.firmware);
+  if (!firmware) return Error{firmware.error()};
+  plan.options.firmware = arguments.firmware;
   const Result<host::Pacing> pacing = host::Pacing::parse(arguments.speed);
   if (!pacing) return Error{pacing.error()};
   plan.pacing = *pacing;
@@ -616,6 +621,13 @@ std::string modules_help() {
   for (const host::ModuleDescriptor& module : host::registered_modules()) {
     text += "\n" + std::string(module.name) + " (firmware " + std::string(module.firmware) + "):\n";
     text += indented(module.help, "  ");
+    if (!module.firmwares.empty()) {
+      text += "  Firmware (--firmware):\n";
+      for (const host::FirmwareGeneration& generation : module.firmwares) {
+        text += "    " + std::string(generation.name) + " (" + std::string(generation.version) + "): " +
+                std::string(generation.help) + "\n";
+      }
+    }
     text += endpoints_help(module.endpoints);
     std::string motors;
     for (std::string_view name : module.motors.names()) motors += std::string(name) + "|";
@@ -709,6 +721,10 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "description file; each module's choices are listed below")
       ->type_name("NAME|FILE")
       ->capture_default_str();
+  serve->add_option("--firmware", arguments->firmware,
+                    "Firmware generation to emulate, for modules that have several (listed below); default: the "
+                    "module's first")
+      ->type_name("VERSION");
   serve->add_option("--scenario", arguments->scenario_path,
                     "Scenario file: lines \"<time_s> <SIGNAL> <value>\" (sim seconds), # comments")
       ->type_name("FILE");

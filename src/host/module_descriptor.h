@@ -39,6 +39,8 @@ struct ModuleOptions {
   std::string motor;
   // CANopen node ID as address switches would set it (`--node-id`, 1..127); 0: the stored one.
   uint8_t node_id = 0;
+  // The firmware generation (`--firmware`, ModuleDescriptor::firmwares); empty: the default.
+  std::string firmware;
   // CANopen identity 1018 sub 4; 0: the module's default (1). Distinct serials tell two
   // unconfigured modules apart in an LSS fastscan.
   uint32_t serial_number = 0;
@@ -87,11 +89,21 @@ struct CanopenDescription {
   CanopenDictionaryView (*dictionary)();
 };
 
+// One generation of a module's firmware that `--firmware` chooses (docs/host-runtime.md "Adding
+// a module"): the same module with another identity and row set, chosen when it is made.
+struct FirmwareGeneration {
+  std::string_view name;     // as --firmware takes it: "1.13"
+  std::string_view version;  // as `serve` prints it (command 136): "1636V113"
+  std::string_view help;     // one line for `serve --help`
+  // `motwin params --firmware NAME`: this generation's parameters.
+  ModuleParameterListing (*listing)();
+};
+
 struct ModuleDescriptor {
   std::string_view name;          // as --module takes it: "tmcm-1636"
   std::string_view product_name;  // as the manuals write it: "TMCM-1636"
   std::string_view summary;       // one line for --help
-  std::string_view firmware;      // as `serve` prints it: "1636V109"
+  std::string_view firmware;      // as `serve` prints it: "1636V109" (the default generation's)
   std::string_view help;          // a paragraph for `serve --help`
   std::span<const sim::SignalInfo> (*input_signals)();
   MakeModuleResult (*make)(const ModuleOptions& options);
@@ -104,6 +116,44 @@ struct ModuleDescriptor {
   ModuleParameterListing (*listing)();
   // nullptr: no CANopen object dictionary (`motwin eds` refuses the module).
   const CanopenDescription* canopen = nullptr;
+  // The firmware generations `--firmware` chooses from, the default (`firmware`) first; empty for
+  // a module with one firmware.
+  std::vector<FirmwareGeneration> firmwares = {};
 };
+
+// "1.09, 1.13": the names --firmware takes for a module (its one version string when it has no
+// generations).
+inline std::string firmware_names(const ModuleDescriptor& module) {
+  if (module.firmwares.empty()) return std::string(module.firmware);
+  std::string names;
+  for (const FirmwareGeneration& generation : module.firmwares) {
+    if (!names.empty()) names += ", ";
+    names += std::string(generation.name);
+  }
+  return names;
+}
+
+// The generation `--firmware NAME` chooses: nullptr for the default (NAME empty, or a module
+// without generations given its one version), an error naming the choices otherwise.
+inline Result<const FirmwareGeneration*> find_firmware(const ModuleDescriptor& module, std::string_view name) {
+  if (name.empty()) return static_cast<const FirmwareGeneration*>(nullptr);
+  if (module.firmwares.empty()) {
+    if (name == module.firmware) return static_cast<const FirmwareGeneration*>(nullptr);
+    return Error{"--firmware " + std::string(name) + ": " + std::string(module.name) + " has one firmware, " +
+                 std::string(module.firmware)};
+  }
+  for (const FirmwareGeneration& generation : module.firmwares) {
+    if (generation.name == name) return &generation;
+  }
+  return Error{"unknown firmware \"" + std::string(name) + "\" for " + std::string(module.name) +
+               " (choices: " + firmware_names(module) + ")"};
+}
+
+// `motwin params`: the parameters of a module's firmware generation (NAME as find_firmware takes it).
+inline Result<ModuleParameterListing> firmware_listing(const ModuleDescriptor& module, std::string_view name) {
+  const Result<const FirmwareGeneration*> generation = find_firmware(module, name);
+  if (!generation) return Error{generation.error()};
+  return *generation != nullptr ? (*generation)->listing() : module.listing();
+}
 
 }  // namespace motwin::host

@@ -73,16 +73,21 @@ ParameterSection user_variable_section(size_t count, size_t storable);
 // A TMCL module's listing: its axis parameter table, its global parameter table (bank 0) and
 // its user variables (bank 2: tmcl::kUserVariableCount, the first ones storable as its NVM
 // layout says). Device::axis_parameters() and Device::global_parameters() are its tables.
+// A module with firmware generations gives the axis table of one.
 template <class Device>
-ModuleParameterListing tmcl_parameter_listing() {
+ModuleParameterListing tmcl_parameter_listing(const params::ParameterTable<Device>& axis_parameters) {
   ModuleParameterListing listing{std::string(Device::kName), {}, {}};
   listing.sections.push_back(
-      section_from_table("Axis parameters", ParameterKind::kAxis, std::nullopt, Device::axis_parameters()));
+      section_from_table("Axis parameters", ParameterKind::kAxis, std::nullopt, axis_parameters));
   listing.sections.push_back(
       section_from_table("Global parameters", ParameterKind::kGlobal, uint8_t{0}, Device::global_parameters()));
   listing.sections.push_back(
       user_variable_section(tmcl::kUserVariableCount, Device::kNvmLayout.storable_user_variables));
   return listing;
+}
+template <class Device>
+ModuleParameterListing tmcl_parameter_listing() {
+  return tmcl_parameter_listing<Device>(Device::axis_parameters());
 }
 
 // A CANopen module's listing: its objects, split into the CiA-301 index areas that hold any.

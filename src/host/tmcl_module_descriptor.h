@@ -18,6 +18,7 @@ struct TmclModuleText {
   std::string_view help;
   std::vector<uint8_t> trace_parameters;  // actual position and velocity
   MotorChoices motors;
+  std::vector<FirmwareGeneration> firmwares = {};  // ModuleDescriptor::firmwares
 };
 
 // `Module` derives from TmclSimModule and has a static make().
@@ -37,6 +38,7 @@ ModuleDescriptor tmcl_module_descriptor(const TmclModuleText& text) {
       .trace_parameters = text.trace_parameters,
       .motors = text.motors,
       .listing = &tmcl_parameter_listing<Device>,
+      .firmwares = text.firmwares,
   };
 }
 

@@ -41,7 +41,10 @@ class TmclSimModule final : public VirtualModule {
 
   // VirtualModule.
   std::string_view name() const override { return Device::kName; }
-  std::string_view firmware_version() const override { return Device::kIdentity.version_string; }
+  // The generation the device was made with (command 136).
+  std::string_view firmware_version() const override {
+    return device_ ? std::string_view(device_->identity().version_string) : std::string_view(Device::kIdentity.version_string);
+  }
   tmcl::TmclEngine& engine() override { return device_->engine(); }
   CanBusNode* can_node() override { return &*can_; }
   TmclCanNode* tmcl_can_node() override { return &*can_; }

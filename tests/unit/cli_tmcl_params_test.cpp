@@ -162,6 +162,57 @@ TEST(CliParams, lists_tmcm1636_parameters_in_each_format) {
   EXPECT_TRUE(contains(markdown.output, "| 43 | max velocity | 0..200000 | 4000 | RWEX | rpm |"));
 }
 
+TEST(CliParams, lists_the_rows_of_a_firmware_generation) {
+  const CompletedProcess v113 = run_motwin({"params", "--module", "tmcm-1636", "--firmware", "1.13", "--format", "csv"});
+  EXPECT_EQ(v113.exit_status, 0) << v113.output;
+  for (const char* row : {"\naxis,,13,motor direction,0,1,0,RWEX,", "\naxis,,26,velocity sensor selection,0,2,0,RWEX,",
+                          "\naxis,,56,position scaler,1,16777215,65536,RWEX,", "\naxis,,94,hall sensor inputs,0,7,0,R,",
+                          "\naxis,,109,encoder inputs,0,7,0,R,", "\naxis,,165,absolute encoder data length,",
+                          "\naxis,,166,absolute encoder position start,", "\naxis,,167,absolute encoder position length,"}) {
+    EXPECT_TRUE(contains(v113.output, row)) << row;
+  }
+  EXPECT_FALSE(contains(v113.output, "dual shunt factor"));
+  const CompletedProcess v109 = run_motwin({"params", "--module", "tmcm-1636", "--firmware", "1.09", "--format", "csv"});
+  EXPECT_EQ(v109.exit_status, 0);
+  EXPECT_TRUE(contains(v109.output, "\naxis,,7,dual shunt factor,"));
+  EXPECT_FALSE(contains(v109.output, "velocity sensor selection"));
+  EXPECT_EQ(v109.output, run_motwin({"params", "--module", "tmcm-1636", "--format", "csv"}).output) << "1.09 is the default";
+  const CompletedProcess unknown = run_motwin({"params", "--module", "tmcm-1636", "--firmware", "9.99"});
+  EXPECT_EQ(unknown.exit_status, 2);
+  EXPECT_EQ(unknown.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13)\n");
+  const CompletedProcess one = run_motwin({"params", "--module", "tmcm-142", "--firmware", "1.13"});
+  EXPECT_EQ(one.exit_status, 2);
+  EXPECT_TRUE(contains(one.output, "tmcm-142 has one firmware")) << one.output;
+}
+
+TEST(CliServe, unknown_firmware_is_refused_with_the_choices) {
+  const CompletedProcess serve = run_motwin({"serve", "--firmware", "9.99", "--state-dir", "none"});
+  EXPECT_EQ(serve.exit_status, 2);
+  EXPECT_EQ(serve.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13)\n");
+  const CompletedProcess other = run_motwin({"serve", "--module", "tmcm-3216", "--firmware", "1.13", "--state-dir", "none"});
+  EXPECT_EQ(other.exit_status, 2);
+  EXPECT_TRUE(contains(other.output, "tmcm-3216 has one firmware")) << other.output;
+  const CompletedProcess run = run_motwin({"run", "missing.tmc", "--for", "1s", "--firmware", "9.99"});
+  EXPECT_EQ(run.exit_status, 2);
+  EXPECT_TRUE(contains(run.output, "unknown firmware \"9.99\"")) << run.output;
+}
+
+TEST(CliServe, firmware_1_13_answers_as_1636V113) {
+  Result<RunningServe> serve = start_serve(
+      MOTWIN_BINARY, {"--module", "tmcm-1636", "--firmware", "1.13", "--tmcl-tcp", "127.0.0.1:0", "--state-dir", "none"});
+  ASSERT_TRUE(serve) << serve.error();
+  const std::optional<std::string> tcp = serve->endpoint("tmcl-tcp");
+  ASSERT_TRUE(tcp);
+  EXPECT_EQ(run_motwin({"tmcl", "--tcp", *tcp, "136", "0"}).output, "version 1636V113\n");
+  EXPECT_EQ(run_motwin({"tmcl", "--tcp", *tcp, "136", "1"}).output, "status 100 (ok) value 107217165\n");  // 0x0664010D
+  // What PyTrinamic's print(motor.drive_settings) reads: GAP 15, 14, 10, 12, 11, 25, 26, 54, 53.
+  for (const char* number : {"15", "14", "10", "12", "11", "25", "26", "54", "53"}) {
+    const CompletedProcess gap = run_motwin({"tmcl", "--tcp", *tcp, "GAP", number, "0"});
+    EXPECT_EQ(gap.exit_status, 0) << "GAP " << number << ": " << gap.output;
+  }
+  EXPECT_EQ(run_motwin({"tmcl", "--tcp", *tcp, "GAP", "7", "0"}).exit_status, 1);
+}
+
 TEST(CliParams, unknown_module_or_format_exits_2) {
   const CompletedProcess module = run_motwin({"params", "--module", "tmcm-9999"});
   EXPECT_EQ(module.exit_status, 2);

@@ -6,13 +6,16 @@ namespace motwin::host {
 
 template <>
 MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
-  // The motor is checked before any file is touched.
+  // The firmware and the motor are checked before any file is touched.
+  const Result<modules::tmcm1636::Firmware> firmware = tmcm1636_firmware(options.firmware);
+  if (!firmware) return Error{firmware.error()};
+  const modules::tmcm1636::Firmware generation = *firmware;
   const Result<sim::MotorChoice> chosen = resolve_tmcm1636_motor(options.motor);
   if (!chosen) return Error{chosen.error()};
   const sim::MotorChoice& motor = *chosen;
   // A physical motor's start-up settings go into a fresh image (docs/tmcm-1636-servo.md).
-  const auto format_image = [&motor](uint8_t* image, size_t size) {
-    Device::format_factory_image(image, size);
+  const auto format_image = [&motor, generation](uint8_t* image, size_t size) {
+    Device::format_factory_image(image, size, Device::axis_parameters(generation));
     if (motor) write_tmcm1636_startup_image(*motor, image, size);
   };
   const auto build_device = [&](Tmcm1636VirtualModule& module) {
@@ -21,7 +24,7 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
       options.log("motwin: the EEPROM image " + module.eeprom_.location() + " has motor type 0 (no motor); " +
                   motor->name + " start-up settings go into new images only (docs/tmcm-1636-servo.md)");
     }
-    module.device_.emplace(nvm, module.io_);
+    module.device_.emplace(nvm, module.io_, generation);
     if (board::Tmcm1636PowerStage* stage = module.board_->power_stage()) module.device_->axis().attach_power_stage(stage);
   };
   return power_up_on_board(options, motor, format_image, build_device);

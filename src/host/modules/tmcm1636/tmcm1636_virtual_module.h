@@ -14,8 +14,13 @@ using Tmcm1636VirtualModule =
     TmclSimModule<modules::tmcm1636::Tmcm1636, sim::Tmcm1636SimIo, sim::Tmcm1636SimBoard,
                   modules::tmcm1636::kControlTickUs, modules::tmcm1636::kControlTickUs * 1e-6>;
 
+// The firmware generations (ModuleDescriptor::firmwares), 1.09 first, and the one a
+// --firmware name chooses (empty: 1.09).
+const std::vector<FirmwareGeneration>& tmcm1636_firmwares();
+Result<modules::tmcm1636::Firmware> tmcm1636_firmware(std::string_view name);
+
 // options.motor: "ideal" (default), a preset or a motor description file
-// (sim/modules/tmcm1636/motor_description.h).
+// (sim/modules/tmcm1636/motor_description.h); options.firmware: a generation's name.
 template <>
 MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options);
 
