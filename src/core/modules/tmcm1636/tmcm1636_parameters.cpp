@@ -52,11 +52,13 @@ int32_t directed(const Tmcm1636& m, int32_t value) {
   return m.axis().config.motor_direction != 0 ? static_cast<int32_t>(0u - static_cast<uint32_t>(value)) : value;
 }
 
-template <const Binding<Tmcm1636>& kMotorFrame>
+// kWritable says whether kMotorFrame has a setter (a function pointer is no constant expression
+// under the sanitizers, so the row tells).
+template <const Binding<Tmcm1636>& kMotorFrame, bool kWritable>
 constexpr Binding<Tmcm1636> host_frame() {
   Binding<Tmcm1636> binding;
   binding.get = [](Tmcm1636& m, uint8_t axis) { return directed(m, kMotorFrame.get(m, axis)); };
-  if constexpr (kMotorFrame.set != nullptr) {
+  if constexpr (kWritable) {
     binding.set = [](Tmcm1636& m, uint8_t axis, int32_t value) { return kMotorFrame.set(m, axis, directed(m, value)); };
   }
   return binding;
@@ -183,9 +185,10 @@ const Tmcm1636::Table& Tmcm1636::axis_parameters(Firmware firmware) {
   // ranges and defaults are Motwin's choice ("inferred" in the doc), as is the meaning of AP 13.
   static constexpr uint16_t kRemovedIn113[] = {7};  // dual shunt factor
   static constexpr params::ReboundRow<Tmcm1636> kReboundIn113[] = {
-    {30, host_frame<kTargetTorque>()}, {31, host_frame<kActualTorque>()},
-    {40, host_frame<kTargetVelocity>()}, {41, host_frame<kRampVelocity>()}, {42, host_frame<kActualVelocity>()},
-    {50, host_frame<kTargetPosition>()}, {51, host_frame<kRampPosition>()}, {52, host_frame<kActualPosition>()},
+    {30, host_frame<kTargetTorque, true>()}, {31, host_frame<kActualTorque, false>()},
+    {40, host_frame<kTargetVelocity, true>()}, {41, host_frame<kRampVelocity, false>()},
+    {42, host_frame<kActualVelocity, false>()}, {50, host_frame<kTargetPosition, true>()},
+    {51, host_frame<kRampPosition, false>()}, {52, host_frame<kActualPosition, true>()},
   };
   static constexpr Row kAddedIn113[] = {
     {{13, "motor direction", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted: the motor turns the other way; AP 30, 31, 40..42, 50..52 change sign between host and motor"}, config_field<&AxisConfig::motor_direction>()},
