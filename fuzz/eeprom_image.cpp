@@ -62,8 +62,9 @@ void load(const std::vector<uint8_t>& bytes) {
 
   const std::string problem = host::EepromFile::validate(identity, bytes).error();
   std::vector<std::string> log;
-  auto opened = host::EepromFile::open(state_dir, identity, &Device::format_factory_image,
-                                       [&log](const std::string& line) { log.push_back(line); });
+  auto opened = host::EepromFile::open(
+      state_dir, identity, [](uint8_t* image, size_t size) { Device::format_factory_image(image, size); },
+      [&log](const std::string& line) { log.push_back(line); });
   FUZZ_CHECK(opened.ok(), "%s: open failed: %s", identity.module_name.c_str(), opened.error().c_str());
   const host::EepromFile& file = **opened;
   if (problem.empty()) {
