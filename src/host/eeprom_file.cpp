@@ -18,7 +18,10 @@ namespace {
 constexpr size_t kFormatVersionOffset = 8;
 constexpr size_t kHeaderSizeOffset = 12;
 constexpr size_t kModuleNameOffset = 16;
-constexpr size_t kModuleNameField = 32;
+constexpr size_t kModuleNameField = 16;
+constexpr size_t kFirmwareOffset = 32;
+constexpr size_t kFirmwareField = 16;
+static_assert(kModuleNameOffset + kModuleNameField == kFirmwareOffset);
 constexpr size_t kLayoutVersionOffset = 48;
 constexpr size_t kPayloadSizeOffset = 52;
 constexpr size_t kPayloadCrcOffset = 56;
@@ -37,6 +40,12 @@ uint32_t get_u32(const uint8_t* in) {
 }
 
 std::string errno_text(int error) { return std::strerror(error); }
+
+// The firmware field of a valid file (empty in an image written before the record existed).
+std::string recorded_firmware_of(const std::vector<uint8_t>& file) {
+  const auto* field = reinterpret_cast<const char*>(&file[kFirmwareOffset]);
+  return std::string(field, strnlen(field, kFirmwareField));
+}
 
 // Reads a whole file. Returns 0, or the errno (ENOENT for a missing file).
 int read_file(const std::filesystem::path& path, std::vector<uint8_t>& out) {
@@ -105,6 +114,8 @@ std::vector<uint8_t> EepromFile::encode(const EepromImageIdentity& identity, con
   put_u32(&file[kHeaderSizeOffset], static_cast<uint32_t>(kHeaderSize));
   std::memcpy(&file[kModuleNameOffset], identity.module_name.data(),
               std::min(identity.module_name.size(), kMaxModuleNameLength));
+  std::memcpy(&file[kFirmwareOffset], identity.firmware_version.data(),
+              std::min(identity.firmware_version.size(), kMaxFirmwareLength));
   put_u32(&file[kLayoutVersionOffset], identity.layout_version);
   put_u32(&file[kPayloadSizeOffset], static_cast<uint32_t>(identity.payload_size));
   if (identity.payload_size > 0) std::memcpy(&file[kHeaderSize], payload, identity.payload_size);
@@ -157,6 +168,9 @@ Result<std::unique_ptr<EepromFile>> EepromFile::open(const std::filesystem::path
   if (identity.module_name.empty() || identity.module_name.size() > kMaxModuleNameLength) {
     return Error{"module name \"" + identity.module_name + "\" does not fit an EEPROM image header"};
   }
+  if (identity.firmware_version.size() > kMaxFirmwareLength) {
+    return Error{"firmware \"" + identity.firmware_version + "\" does not fit an EEPROM image header"};
+  }
   std::error_code ec;
   std::filesystem::create_directories(state_dir, ec);
   if (ec) return Error{"cannot create state directory " + state_dir.string() + ": " + ec.message()};
@@ -197,6 +211,7 @@ Result<std::unique_ptr<EepromFile>> EepromFile::open(const std::filesystem::path
     (void)::rename(path.c_str(), damaged_path.c_str());
   } else {
     std::memcpy(file->image_.data(), bytes.data() + kHeaderSize, identity.payload_size);
+    file->recorded_firmware_ = recorded_firmware_of(bytes);
     return file;
   }
   format_factory_image(file->image_.data(), file->image_.size());
@@ -219,6 +234,16 @@ EepromFile::EepromFile(std::filesystem::path path, EepromImageIdentity identity,
 EepromFile::~EepromFile() {
   ::close(lock_fd_);
   ::close(directory_fd_);
+}
+
+bool EepromFile::record_running_firmware() {
+  if (recorded_firmware_ == identity_.firmware_version) return true;
+  if (const int error = persist(); error != 0) {
+    last_write_errno_ = error;
+    if (log_) log_("motwin: cannot write EEPROM image " + path_.string() + ": " + errno_text(error));
+    return false;
+  }
+  return true;
 }
 
 bool EepromFile::write(size_t offset, const uint8_t* bytes, size_t length) {
@@ -267,7 +292,10 @@ int EepromFile::persist() {
   // loss could still bring back the old one, so report the write as failed (docs/host-runtime.md).
   error = injected_fault(PersistStep::kSyncDirectory);
   if (error == 0 && ::fsync(directory_fd_) != 0) error = errno;
-  if (error == 0) ++persist_count_;
+  if (error == 0) {
+    ++persist_count_;
+    recorded_firmware_ = identity_.firmware_version;
+  }
   return error;
 }
 

@@ -6,7 +6,10 @@
 //   0  8  magic "MOTWINEE"
 //   8  4  file format version (kFormatVersion)
 //  12  4  header size (kHeaderSize)
-//  16 32  module name, ASCII, NUL padded ("tmcm-1636")
+//  16 16  module name, ASCII, NUL padded ("tmcm-1636")
+//  32 16  firmware that last wrote the image, ASCII, NUL padded ("1636V113"); all NUL in an
+//         image written before the record existed (the name field was 32 bytes then, always
+//         NUL after the name, so old and new readers agree on both fields)
 //  48  4  module NVM layout version (e.g. Tmcm1636::kNvmLayoutVersion)
 //  52  4  payload size in bytes
 //  56  4  CRC-32 of the payload
@@ -36,6 +39,10 @@ struct EepromImageIdentity {
   std::string module_name;  // at most EepromFile::kMaxModuleNameLength characters
   uint32_t layout_version;  // bumped by the module whenever its stored layout changes
   size_t payload_size;
+  // The running firmware ("1636V113", at most EepromFile::kMaxFirmwareLength characters),
+  // recorded in every write. Another firmware's record is no damage: the module decides what
+  // a firmware change does to the image (ModuleEeprom::open).
+  std::string firmware_version = {};
 };
 
 // Fills `image` (payload_size bytes) with the module's factory defaults.
@@ -58,7 +65,8 @@ class EepromFile final : public board::NonVolatileMemory {
   static constexpr char kMagic[8] = {'M', 'O', 'T', 'W', 'I', 'N', 'E', 'E'};
   static constexpr uint32_t kFormatVersion = 1;
   static constexpr size_t kHeaderSize = 64;
-  static constexpr size_t kMaxModuleNameLength = 31;
+  static constexpr size_t kMaxModuleNameLength = 15;
+  static constexpr size_t kMaxFirmwareLength = 15;
 
   // Creates `state_dir` if needed, takes an exclusive lock (`<path>.lock`, so that two servers
   // never write one image), removes a temporary file left by a crash, and loads the image.
@@ -87,6 +95,13 @@ class EepromFile final : public board::NonVolatileMemory {
 
   const std::filesystem::path& path() const { return path_; }
   EepromLoadOutcome load_outcome() const { return load_outcome_; }
+  // The firmware the file on disk records: the one that last wrote it (empty for an image
+  // written before the record existed); after open() and before any write, the firmware the
+  // image comes from.
+  const std::string& recorded_firmware() const { return recorded_firmware_; }
+  // Rewrites the file so that it records the running firmware (identity.firmware_version), if it
+  // does not yet. False (and one log line) when the write fails.
+  bool record_running_firmware();
   // errno of the last failed write (0 if none failed).
   int last_write_errno() const { return last_write_errno_; }
   size_t persist_count() const { return persist_count_; }
@@ -115,6 +130,7 @@ class EepromFile final : public board::NonVolatileMemory {
   int directory_fd_;
   int lock_fd_;
   std::vector<uint8_t> image_;
+  std::string recorded_firmware_;
   EepromLoadOutcome load_outcome_ = EepromLoadOutcome::kLoaded;
   int last_write_errno_ = 0;
   size_t persist_count_ = 0;

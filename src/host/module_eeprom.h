@@ -4,8 +4,10 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "board/non_volatile_memory.h"
@@ -27,11 +29,26 @@ constexpr size_t nvm_image_size_of() {
   }
 }
 
-// What a module's image file is checked against: the module's name, layout version and size.
 template <typename Device>
-EepromImageIdentity eeprom_identity_of() {
-  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, nvm_image_size_of<Device>()};
+constexpr std::string_view default_firmware_of() {
+  if constexpr (requires { Device::kIdentity.version_string; }) {
+    return Device::kIdentity.version_string;
+  } else {
+    return Device::kFirmwareVersion;
+  }
 }
+
+// What a module's image file is checked against: the module's name, layout version and size;
+// and the firmware it records (by default the module's one version string).
+template <typename Device>
+EepromImageIdentity eeprom_identity_of(std::string_view firmware_version = default_firmware_of<Device>()) {
+  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, nvm_image_size_of<Device>(),
+                             std::string(firmware_version)};
+}
+
+// What starting another firmware on an existing image does to it, before the firmware powers up
+// (a firmware update on the real module): `previous` is the recorded firmware's version string.
+using FirmwareUpdate = std::function<void(std::string_view previous, board::NonVolatileMemory& nvm)>;
 
 template <size_t kImageSize>
 class ModuleEeprom {
@@ -39,15 +56,25 @@ class ModuleEeprom {
   using MemoryImage = board::RamNonVolatileMemory<kImageSize>;
 
   // Opens (or creates) the file when options.state_dir is set, otherwise formats a memory image.
-  // Fails when the file cannot be used.
+  // A file that another firmware wrote is updated by `firmware_update` (one log line says so)
+  // and then records the running firmware; a file written before the record existed just gets
+  // the record. Fails when the file cannot be used.
   Result<void> open(const ModuleOptions& options, const EepromImageIdentity& identity,
-                    const FactoryImageFormatter& format_factory_image) {
+                    const FactoryImageFormatter& format_factory_image, const FirmwareUpdate& firmware_update = {}) {
     if (options.state_dir) {
       Result<std::unique_ptr<EepromFile>> opened =
           EepromFile::open(*options.state_dir, identity, format_factory_image, options.log);
       if (!opened) return Error{opened.error()};
       file_ = std::move(*opened);
       nvm_ = file_.get();
+      const std::string previous = file_->recorded_firmware();
+      if (!previous.empty() && previous != identity.firmware_version) {
+        options.log("motwin: EEPROM image " + file_->path().string() + " was written by firmware " + previous +
+                    "; " + identity.firmware_version + " takes it over like a firmware update");
+        if (firmware_update) firmware_update(previous, *nvm_);
+      }
+      // A failed write was logged; the image in memory is intact, the record follows later.
+      (void)file_->record_running_firmware();
     } else {
       memory_image_ = std::make_unique<MemoryImage>();
       format_factory_image(memory_image_->mutable_data(), memory_image_->size());

@@ -32,7 +32,6 @@ class TmclSimModule final : public VirtualModule {
   // Defined by each module (template <> ... ::make in src/host/modules/<module>/).
   static MakeModuleResult make(const ModuleOptions& options);
 
-  static EepromImageIdentity eeprom_identity() { return eeprom_identity_of<Device>(); }
   // The inputs `--set` and scenario files address.
   static std::span<const sim::SignalInfo> signal_table() { return SimBoard::signal_table(); }
 
@@ -68,11 +67,16 @@ class TmclSimModule final : public VirtualModule {
   // one formatted by `format_image`), builds the board on the motor, sets the initial inputs,
   // lets `build_device` construct device_ (and do what the module needs around it), powers the
   // firmware up and adds TMCL over CAN. The module, or the error of an unusable image.
+  // `firmware` is the running generation's version string and `firmware_update` what starting it
+  // on another generation's image does (ModuleEeprom::open).
   template <class Motor, class FormatImage, class BuildDevice>
   static MakeModuleResult power_up_on_board(const ModuleOptions& options, const std::optional<Motor>& motor,
-                                            const FormatImage& format_image, const BuildDevice& build_device) {
+                                            const FormatImage& format_image, const BuildDevice& build_device,
+                                            std::string_view firmware = Device::kIdentity.version_string,
+                                            const FirmwareUpdate& firmware_update = {}) {
     std::unique_ptr<TmclSimModule> module(new TmclSimModule());
-    const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), format_image);
+    const Result<void> eeprom =
+        module->eeprom_.open(options, eeprom_identity_of<Device>(firmware), format_image, firmware_update);
     if (!eeprom) return Error{eeprom.error()};
     module->board_ = motor ? std::make_unique<SimBoard>(module->io_, *motor) : std::make_unique<SimBoard>(module->io_);
     for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);

@@ -393,7 +393,7 @@ class Server:
     endpoints overrides BANNER and PORT_ENDPOINTS (canopen_harness.CanServer)."""
 
     # The banner line; its group is the EEPROM image's path.
-    BANNER = r"motwin: tmcm-1636 \(1636V109\) eeprom (.+)"
+    BANNER = r"motwin: tmcm-1636 \(1636V1\d\d\) eeprom (.+)"  # either firmware generation
     # `endpoint KIND 127.0.0.1:PORT` lines: KIND -> the attribute that keeps the port.
     PORT_ENDPOINTS = {"tmcl-tcp": "tcp_port"}
 
@@ -667,12 +667,14 @@ NVM_GLOBAL_OFFSET = 256 * 4
 NVM_USER_OFFSET = NVM_GLOBAL_OFFSET + 256 * 4
 
 
-def encode_eeprom_image(module_name, layout_version, payload, format_version=1):
+def encode_eeprom_image(module_name, layout_version, payload, format_version=1, firmware=""):
     header = bytearray(EEPROM_HEADER_SIZE)
     header[0:8] = EEPROM_MAGIC
     struct.pack_into("<II", header, 8, format_version, EEPROM_HEADER_SIZE)
-    name = module_name.encode("ascii")[:31]
+    name = module_name.encode("ascii")[:15]
     header[16:16 + len(name)] = name
+    recorded = firmware.encode("ascii")[:15]
+    header[32:32 + len(recorded)] = recorded
     struct.pack_into("<III", header, 48, layout_version, len(payload), zlib.crc32(payload) & 0xFFFFFFFF)
     struct.pack_into("<I", header, 60, zlib.crc32(bytes(header[:60])) & 0xFFFFFFFF)
     return bytes(header) + bytes(payload)
@@ -685,6 +687,7 @@ class EepromImage:
         self.data = data
         self.problem = None
         self.module_name = None
+        self.firmware = None
         self.layout_version = None
         self.payload = b""
         if len(data) < EEPROM_HEADER_SIZE:
@@ -696,7 +699,8 @@ class EepromImage:
         if struct.unpack_from("<I", data, 60)[0] != zlib.crc32(data[:60]) & 0xFFFFFFFF:
             self.problem = "header CRC"
             return
-        self.module_name = data[16:48].split(b"\0", 1)[0].decode("ascii", "replace")
+        self.module_name = data[16:32].split(b"\0", 1)[0].decode("ascii", "replace")
+        self.firmware = data[32:48].split(b"\0", 1)[0].decode("ascii", "replace")
         self.layout_version, payload_size, payload_crc = struct.unpack_from("<III", data, 48)
         self.payload = data[EEPROM_HEADER_SIZE:]
         if len(self.payload) != payload_size:

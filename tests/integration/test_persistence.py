@@ -119,6 +119,32 @@ def test_restart_keeps_stored_values(motwin):
 
 
 
+def test_another_firmware_takes_the_image_over(motwin):
+    """`--firmware 1.13` on a 1.09 image (docs/tmcm-1636.md "EEPROM image and firmware changes"):
+    one stderr line names both firmwares, nothing is called damaged, the stored settings stay,
+    1.13's new rows have their defaults and the header records 1636V113 from then on."""
+    with TempDir() as tmp:
+        state = os.path.join(tmp, "state")
+        with Server(motwin, state) as server:
+            with server.tcp() as c:
+                store_some_values(c)
+            server.stop()
+        check_equal(read_eeprom_image(image_path(state)).firmware, "1636V109", "firmware recorded by 1.09")
+        with Server(motwin, state, extra_args=["--firmware", "1.13"]) as server:
+            with server.tcp() as c:
+                check_stored_values(c, "1.13 on the 1.09 image")
+                check_equal(c.gap(56), 65536, "AP 56 (new in 1.13) at its default")
+            server.stop()
+            lines = server.stderr_lines()
+            check_no_damaged(server, "firmware change")
+            update = [line for line in lines if "was written by firmware 1636V109; 1636V113 takes it over" in line]
+            check_equal(len(update), 1, f"one line about the firmware change in {lines!r}")
+        image = read_eeprom_image(image_path(state))
+        check(image.problem is None, f"image after the firmware change is invalid: {image.problem}")
+        check_equal(image.firmware, "1636V113", "firmware recorded after the change")
+        check_equal(image.axis_parameter(43), 3100, "AP 43 slot kept")
+
+
 def test_gp_85_decides_whether_user_variables_come_back(motwin):
     """GP 85 = 1 (stored at once, like every SGP from 64 on): after a restart the stored user
     variables start at 0, and RSGP still fetches the stored copy; GP 85 = 0: they come back."""
@@ -456,5 +482,5 @@ def test_sigterm_under_load(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_restart_keeps_stored_values, test_gp_85_decides_whether_user_variables_come_back,
+    run_tests([test_restart_keeps_stored_values, test_another_firmware_takes_the_image_over, test_gp_85_decides_whether_user_variables_come_back,
                test_damaged_images, test_state_dir_in_use, test_sigterm_under_load, test_kill9_loop])

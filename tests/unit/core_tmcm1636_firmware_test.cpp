@@ -120,6 +120,43 @@ TEST(Tmcm1636Firmware, a_1_09_image_starts_1_13_with_defaults_for_the_new_rows) 
   }
 }
 
+// What the host does when the image records the other generation: rows new to the running one
+// get their defaults even where the slot holds something a value in range (left by the other
+// generation, or by a 1.13 factory reset that wrote 0 over AP 7); shared rows stay.
+TEST(Tmcm1636Firmware, a_firmware_update_gives_the_new_rows_their_defaults_and_keeps_the_rest) {
+  constexpr tmcl::NvmLayout kLayout = Tmcm1636::kNvmLayout;
+  Tmcm1636Nvm nvm;
+  Tmcm1636::format_factory_image(nvm.mutable_data(), nvm.size(), Tmcm1636::axis_parameters(Firmware::kV109));
+  const auto slot = [&](uint32_t offset) { return tmcl::get_le32(nvm.data() + offset); };
+  const auto put = [&](uint32_t offset, int32_t value) {
+    uint8_t bytes[4];
+    tmcl::put_le32(bytes, value);
+    ASSERT_TRUE(nvm.write(offset, bytes, sizeof bytes));
+  };
+  put(kLayout.axis_parameter(0, 56), 24);    // in AP 56's range: power-up alone would take it
+  put(kLayout.axis_parameter(0, 13), 1);     // likewise AP 13
+  put(kLayout.axis_parameter(0, 7), 300);    // 1.09's dual shunt factor, as stored
+  put(kLayout.axis_parameter(0, 43), 1234);  // a row both generations have
+  put(kLayout.global_parameter(77), 0);
+  put(kLayout.user_variable(3), -5);
+
+  ASSERT_TRUE(Tmcm1636::update_image_for_firmware(nvm, Tmcm1636::axis_parameters(Firmware::kV109),
+                                                  Tmcm1636::axis_parameters(Firmware::kV113)));
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 56)), 65536);
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 13)), 0);
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 7)), 300);  // 1.13 leaves a slot it has no row for alone
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 43)), 1234);
+  EXPECT_EQ(slot(kLayout.global_parameter(77)), 0);
+  EXPECT_EQ(slot(kLayout.user_variable(3)), -5);
+
+  // And back: AP 7 is new to 1.09 coming from 1.13, whatever its slot holds.
+  ASSERT_TRUE(Tmcm1636::update_image_for_firmware(nvm, Tmcm1636::axis_parameters(Firmware::kV113),
+                                                  Tmcm1636::axis_parameters(Firmware::kV109)));
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 7)), 256);
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 43)), 1234);
+  EXPECT_EQ(slot(kLayout.axis_parameter(0, 56)), 65536);  // 1.09 has no AP 56: the slot is kept
+}
+
 TEST(Tmcm1636Firmware, ap13_inverts_the_motion_of_the_ideal_motor) {
   Tmcm1636Rig rig(Firmware::kV113);
   ASSERT_EQ(rig.command(kSap, 13, 0, 1).status, kOk);

@@ -24,8 +24,9 @@ using testing::ScratchDirectory;
 
 constexpr size_t kPayloadSize = 256;
 
-EepromImageIdentity identity(std::string name = "tmcm-1636", uint32_t layout_version = 1, size_t size = kPayloadSize) {
-  return EepromImageIdentity{std::move(name), layout_version, size};
+EepromImageIdentity identity(std::string name = "tmcm-1636", uint32_t layout_version = 1, size_t size = kPayloadSize,
+                             std::string firmware = "1636V113") {
+  return EepromImageIdentity{std::move(name), layout_version, size, std::move(firmware)};
 }
 
 // A factory image that is not all zeros, so that "factory" is recognisable.
@@ -98,6 +99,7 @@ TEST(EepromFile, header_fields_are_where_the_documentation_says) {
   EXPECT_EQ(file[8], 1);   // format version, little-endian
   EXPECT_EQ(file[12], 64); // header size
   EXPECT_EQ(std::string(reinterpret_cast<const char*>(&file[16])), "tmcm-1636");
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(&file[32])), "1636V113");  // firmware
   EXPECT_EQ(file[48], 7);  // layout version
   EXPECT_EQ(file[52] | (file[53] << 8), static_cast<int>(kPayloadSize));
   const uint32_t payload_crc = crc32(payload.data(), payload.size());
@@ -130,6 +132,57 @@ TEST(EepromFile, writes_survive_a_reopen) {
   expected[102] = 3;
   expected[103] = 4;
   EXPECT_EQ(std::vector<uint8_t>(reopened.result.file->data(), reopened.result.file->data() + kPayloadSize), expected);
+}
+
+// The firmware record (docs/host-runtime.md "EEPROM image files"): another firmware's image is
+// loaded, not replaced, and says which firmware wrote it until the running one rewrites it.
+TEST(EepromFile, records_the_firmware_that_last_wrote_it) {
+  ScratchDirectory scratch;
+  const EepromImageIdentity old_firmware = identity("tmcm-1636", 1, kPayloadSize, "1636V109");
+  {
+    Opened created = open_in(scratch.path(), old_firmware);
+    ASSERT_TRUE(created.result.file) << created.result.error;
+    EXPECT_EQ(created.result.file->recorded_firmware(), "1636V109");
+    const uint8_t value[4] = {9, 8, 7, 6};
+    ASSERT_TRUE(created.result.file->write(40, value, 4));
+  }
+  Opened opened = open_in(scratch.path(), identity());
+  ASSERT_TRUE(opened.result.file) << opened.result.error;
+  EepromFile& file = *opened.result.file;
+  EXPECT_EQ(file.load_outcome(), EepromLoadOutcome::kLoaded);
+  EXPECT_TRUE(opened.log.empty());
+  EXPECT_EQ(file.recorded_firmware(), "1636V109");
+  EXPECT_EQ(file.data()[41], 8);
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(&read_all(file.path())[32])), "1636V109");
+  ASSERT_TRUE(file.record_running_firmware());
+  EXPECT_EQ(file.recorded_firmware(), "1636V113");
+  const std::vector<uint8_t> on_disk = read_all(file.path());
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(&on_disk[32])), "1636V113");
+  EXPECT_EQ(on_disk[64 + 41], 8);
+  const size_t writes = file.persist_count();
+  ASSERT_TRUE(file.record_running_firmware());
+  EXPECT_EQ(file.persist_count(), writes) << "already recorded: no write";
+}
+
+// An image from before the record (a 32-byte name field, NUL after the name) loads as it is and
+// records no firmware; a name that would run into the record does not fit.
+TEST(EepromFile, an_image_without_a_firmware_record_loads_and_long_names_are_refused) {
+  ScratchDirectory scratch;
+  const std::vector<uint8_t> payload = factory_bytes();
+  write_all(EepromFile::image_path(scratch.path(), "tmcm-1636"),
+            EepromFile::encode(identity("tmcm-1636", 1, kPayloadSize, ""), payload.data()));
+  Opened opened = open_in(scratch.path());
+  ASSERT_TRUE(opened.result.file) << opened.result.error;
+  EXPECT_EQ(opened.result.file->load_outcome(), EepromLoadOutcome::kLoaded);
+  EXPECT_EQ(opened.result.file->recorded_firmware(), "");
+
+  ScratchDirectory other;
+  Opened long_name = open_in(other.path(), identity("a-sixteen-chars!", 1));
+  EXPECT_FALSE(long_name.result.file);
+  EXPECT_NE(long_name.result.error.find("does not fit"), std::string::npos) << long_name.result.error;
+  Opened long_firmware = open_in(other.path(), identity("tmcm-1636", 1, kPayloadSize, "1636V1130000000000"));
+  EXPECT_FALSE(long_firmware.result.file);
+  EXPECT_NE(long_firmware.result.error.find("does not fit"), std::string::npos) << long_firmware.result.error;
 }
 
 TEST(EepromFile, writes_out_of_bounds_are_refused) {

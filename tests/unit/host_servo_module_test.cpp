@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -26,9 +27,10 @@ tmcl::CommandResult execute(VirtualModule& module, uint8_t command, uint8_t type
 int32_t gap(VirtualModule& module, uint8_t number) { return execute(module, kGap, number, 0).value; }
 
 MakeModuleResult make_with_motor(const std::string& motor, std::optional<std::filesystem::path> state_dir = {},
-                                 std::vector<std::string>* log = nullptr) {
+                                 std::vector<std::string>* log = nullptr, const std::string& firmware = "") {
   ModuleOptions options;
   options.motor = motor;
+  options.firmware = firmware;
   options.state_dir = state_dir;
   options.log = [log](const std::string& line) {
     if (log != nullptr) log->push_back(line);
@@ -136,6 +138,57 @@ TEST(ServoModule, a_scenario_load_step_is_rejected_and_runs_are_bit_identical) {
     EXPECT_EQ(std::memcmp(&other_batching[i], &first[2 * j], 2 * sizeof(double)), 0) << "sample " << i / 2;
     if (::testing::Test::HasFailure()) break;
   }
+}
+
+}  // namespace
+}  // namespace motwin::host
+
+namespace motwin::host {
+namespace {
+
+// docs/tmcm-1636.md "EEPROM image and firmware changes": starting 1.13 on a 1.09 image keeps the
+// settings both have, gives the new rows their defaults, records 1.13 and says so once; going
+// back is an update too: AP 7, new to 1.09 from 1.13's side, starts at its default.
+TEST(ServoModule, another_firmware_on_a_state_directory_behaves_like_a_firmware_update) {
+  testing::ScratchDirectory scratch;
+  {
+    MakeModuleResult made = make_with_motor("", scratch.path(), nullptr, "1.09");
+    ASSERT_TRUE(made) << made.error();
+    for (const auto& [number, value] : {std::pair<uint8_t, int32_t>{43, 1234}, {7, 300}}) {
+      ASSERT_EQ(execute(**made, kSap, number, value).status, tmcl::Status::kOk);
+      ASSERT_EQ(execute(**made, kStap, number, 0).status, tmcl::Status::kOk);
+    }
+  }
+  const std::filesystem::path image = EepromFile::image_path(scratch.path(), "tmcm-1636");
+  const auto recorded = [&image] {
+    std::ifstream file(image, std::ios::binary);
+    char header[64] = {};
+    file.read(header, sizeof header);
+    return std::string(header + 32);
+  };
+  EXPECT_EQ(recorded(), "1636V109");
+  {
+    std::vector<std::string> log;
+    MakeModuleResult made = make_with_motor("", scratch.path(), &log, "1.13");
+    ASSERT_TRUE(made) << made.error();
+    ASSERT_EQ(log.size(), 1u);
+    EXPECT_NE(log[0].find("written by firmware 1636V109; 1636V113 takes it over"), std::string::npos) << log[0];
+    EXPECT_EQ(recorded(), "1636V113");
+    EXPECT_EQ(gap(**made, 43), 1234);
+    EXPECT_EQ(gap(**made, 56), 65536);
+    EXPECT_EQ(execute(**made, kGap, 7, 0).status, tmcl::Status::kWrongType);
+  }
+  {
+    std::vector<std::string> log;
+    MakeModuleResult made = make_with_motor("", scratch.path(), &log, "1.13");
+    ASSERT_TRUE(made) << made.error();
+    EXPECT_TRUE(log.empty()) << "the same firmware again: nothing to say";
+  }
+  MakeModuleResult back = make_with_motor("", scratch.path(), nullptr, "1.09");
+  ASSERT_TRUE(back) << back.error();
+  EXPECT_EQ(gap(**back, 7), 256);
+  EXPECT_EQ(gap(**back, 43), 1234);
+  EXPECT_EQ(recorded(), "1636V109");
 }
 
 }  // namespace

@@ -69,6 +69,29 @@ class ModuleStorage : public TmclDevice {
     }
   }
 
+  // Starting one firmware generation on an image another generation wrote (a firmware update,
+  // docs/tmcm-1636.md "EEPROM image and firmware changes"): each stored axis row of `running` that
+  // `previous` lacks gets its factory default in its slot, so that whatever the other generation
+  // left there is never taken for a setting. Rows both have, bank 0, user variables and the
+  // program stay as stored. One write of the axis area; false when it failed.
+  static bool update_image_for_firmware(board::NonVolatileMemory& nvm, const params::ParameterTable<Derived>& previous,
+                                        const params::ParameterTable<Derived>& running) {
+    constexpr NvmLayout layout = Derived::kNvmLayout;
+    constexpr uint32_t kAxisAreaBytes = layout.global_parameters_offset - layout.axis_parameters_offset;
+    if (nvm.size() < layout.total_size) return false;
+    static uint8_t axis_area[kAxisAreaBytes];
+    std::memcpy(axis_area, nvm.data() + layout.axis_parameters_offset, kAxisAreaBytes);
+    for (const auto& row : running.rows()) {
+      if (!is_stored_parameter(row.info) || previous.find(row.info.number) != nullptr) continue;
+      for (uint8_t motor = 0; motor < Derived::kMotorCount; ++motor) {
+        put_le32(axis_area + layout.axis_parameter(motor, static_cast<uint8_t>(row.info.number)) -
+                     layout.axis_parameters_offset,
+                 static_cast<int32_t>(row.info.default_value));
+      }
+    }
+    return nvm.write(layout.axis_parameters_offset, axis_area, kAxisAreaBytes);
+  }
+
   std::array<int32_t, kUserVariableCount>& user_variables() { return user_variables_; }
   // True when the last EEPROM write failed (reported by the host runtime).
   bool last_store_failed() const { return last_store_failed_; }

@@ -27,7 +27,20 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
     module.device_.emplace(nvm, module.io_, generation);
     if (board::Tmcm1636PowerStage* stage = module.board_->power_stage()) module.device_->axis().attach_power_stage(stage);
   };
-  return power_up_on_board(options, motor, format_image, build_device);
+  // An image another generation wrote: the rows this one adds get their defaults (a firmware
+  // update, docs/tmcm-1636.md "EEPROM image and firmware changes"); a version Motwin does not
+  // know (a later Motwin's) is taken as it is.
+  const auto firmware_update = [generation, &options](std::string_view previous, board::NonVolatileMemory& nvm) {
+    for (const modules::tmcm1636::Firmware known : {modules::tmcm1636::Firmware::kV109, modules::tmcm1636::Firmware::kV113}) {
+      if (Device::identity_of(known).version_string != previous) continue;
+      if (!Device::update_image_for_firmware(nvm, Device::axis_parameters(known), Device::axis_parameters(generation))) {
+        options.log("motwin: the EEPROM image could not be updated; the firmware's rows keep what is stored");
+      }
+      return;
+    }
+  };
+  return power_up_on_board(options, motor, format_image, build_device,
+                           Device::identity_of(generation).version_string, firmware_update);
 }
 
 }  // namespace motwin::host
