@@ -650,7 +650,7 @@ void add_serve_command(CLI::App& app, int& exit_status) {
   serve->add_option("--node", arguments->nodes,
                     "Put several modules on one CAN bus in this process instead of --module: "
                     "MODULE[:KEY=VALUE,...] with keys name (state subdirectory, default MODULE-POSITION), node-id "
-                    "and serial (CANopen), motor, receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
+                    "and serial (CANopen), motor, firmware (as --firmware), receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
                     "CAN only (see the examples below)")
       ->type_name("MODULE[:KEY=VALUE,...]")
       ->expected(1)

@@ -53,13 +53,15 @@ Result<void> apply_node_key(std::string_view item, NodeSpec& spec) {
     spec.serial_number = static_cast<uint32_t>(*number);
   } else if (key == "motor") {
     spec.motor = std::string(value);
+  } else if (key == "firmware") {
+    spec.firmware = std::string(value);
   } else if (key == "receive-id" || key == "send-id") {
     if (!number || *number < 0 || *number > 255) {
       return Error{std::string(key) + " must be 0..255 (GP 70/71), got \"" + std::string(value) + "\""};
     }
     (key == "receive-id" ? spec.receive_id : spec.send_id) = static_cast<int32_t>(*number);
   } else {
-    return Error{"unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, receive-id, send-id)"};
+    return Error{"unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, firmware, receive-id, send-id)"};
   }
   return {};
 }
@@ -73,6 +75,7 @@ Result<std::unique_ptr<VirtualModule>> make_member(const NodeSpec& spec,
   options.node_id = spec.node_id;
   options.serial_number = spec.serial_number;
   options.motor = spec.motor;
+  options.firmware = spec.firmware;
   options.log = log;
   MakeModuleResult made = make_module(spec.module, options);
   if (!made) return made;
@@ -108,6 +111,10 @@ Result<NodeSpec> parse_node_spec(std::string_view text, size_t position) {
     const std::string_view item = rest.substr(0, comma);
     rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
     if (const Result<void> applied = apply_node_key(item, spec); !applied) return Error{applied.error()};
+  }
+  if (const Result<const FirmwareGeneration*> firmware = find_firmware(*find_module(spec.module), spec.firmware);
+      !firmware) {
+    return Error{firmware.error()};
   }
   return spec;
 }

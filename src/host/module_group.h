@@ -23,6 +23,7 @@ struct NodeSpec {
   uint8_t node_id = 0;       // node-id=N (CANopen modules)
   uint32_t serial_number = 0;  // serial=N (CANopen identity 1018 sub 4)
   std::string motor;         // motor=NAME|FILE (TMCM-1636)
+  std::string firmware;      // firmware=NAME (ModuleDescriptor::firmwares; empty: the default)
   int32_t receive_id = -1;   // receive-id=N (TMCL modules: GP 71 at start-up)
   int32_t send_id = -1;      // send-id=N (GP 70)
 };

@@ -292,6 +292,21 @@ TEST(ModuleGroup, parses_node_options) {
   EXPECT_FALSE(parse_node_spec("tmcm-3216:colour=red", 1));
   EXPECT_FALSE(parse_node_spec("tmcm-3216:name=../x", 1));
   EXPECT_FALSE(parse_node_spec("tmcm-1636:receive-id=256", 1));
+  const Result<NodeSpec> later = parse_node_spec("tmcm-1636:firmware=1.13", 1);
+  ASSERT_TRUE(later) << later.error();
+  EXPECT_EQ(later->firmware, "1.13");
+  const Result<NodeSpec> unknown_firmware = parse_node_spec("tmcm-1636:firmware=2.0", 1);
+  ASSERT_FALSE(unknown_firmware);
+  EXPECT_NE(unknown_firmware.error().find("choices: 1.09, 1.13"), std::string::npos) << unknown_firmware.error();
+  EXPECT_FALSE(parse_node_spec("tmcm-3216:firmware=1.13", 1)) << "one firmware only";
+}
+
+// firmware=1.13 reaches the member: command 136 over CAN answers the later generation.
+TEST(ModuleGroup, a_node_runs_the_firmware_its_spec_names) {
+  std::vector<NodeSpec> specs{*parse_node_spec("tmcm-1636:firmware=1.13", 1)};
+  Result<std::unique_ptr<ModuleGroup>> made = ModuleGroup::make(specs, std::nullopt, [](const std::string&) {});
+  ASSERT_TRUE(made) << made.error();
+  EXPECT_EQ((*made)->members()[0].module->firmware_version(), "1636V113");
 }
 
 TEST(ModuleGroup, members_share_one_clock_and_answer_only_their_own_ids) {
