@@ -5,6 +5,7 @@
 
 #include "cli/cli_errors.h"
 #include "cli/commands.h"
+#include "cli/usage_hints.h"
 #include "host/module_registry.h"
 
 namespace {
@@ -39,9 +40,12 @@ int main(int argc, char** argv) {
   motwin::cli::add_lss_command(app, exit_status);
   // Usage errors look like every other error and exit with status 2 (CLI11's own codes are
   // 100 and up); --help still exits 0.
-  app.failure_message([](const CLI::App*, const CLI::Error& error) {
-    return std::string("motwin: error: ") + error.what() + " (see --help)\n";
+  app.failure_message([](const CLI::App* failed, const CLI::Error& error) {
+    return "motwin: error: " + motwin::cli::explain_parse_error(*failed, error) + " (see --help)\n";
   });
+  if (const std::string unknown = motwin::cli::unknown_command_message(app, argc, argv); !unknown.empty()) {
+    return motwin::cli::usage_error(unknown + " (see --help)");
+  }
   // The only exceptions: CLI11 reports bad arguments with one, and anything the commands did not
   // foresee (out of memory, say) ends here as an error line rather than an abort.
   try {

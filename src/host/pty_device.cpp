@@ -3,12 +3,17 @@
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <cstddef>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 #include <fcntl.h>
 #include <sys/ioctl.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/un.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -49,15 +54,62 @@ Result<void> place_link(const std::string& link_path, const std::string& device_
   return {};
 }
 
+// The link's absolute path with its directory resolved ("./x" and "/tmp/../tmp/x" are one link).
+std::string absolute_link_path(const std::string& link_path) {
+  std::error_code ignored;
+  const std::filesystem::path absolute = std::filesystem::absolute(link_path, ignored);
+  const std::filesystem::path directory = std::filesystem::weakly_canonical(absolute.parent_path(), ignored);
+  return (directory / absolute.filename()).string();
+}
+
+// FNV-1a: a long path still gets a short, stable socket name.
+uint64_t fnv1a(const std::string& text) {
+  uint64_t hash = 14695981039346656037ull;
+  for (const char c : text) hash = (hash ^ static_cast<uint8_t>(c)) * 1099511628211ull;
+  return hash;
+}
+
 }  // namespace
 
+Result<int> claim_pty_link(const std::string& link_path) {
+  const std::string absolute = absolute_link_path(link_path);
+  std::string name = "motwin-pty-link:" + absolute;
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (name.size() + 1 > sizeof(address.sun_path)) {
+    char hashed[32];
+    std::snprintf(hashed, sizeof hashed, "%016llx", static_cast<unsigned long long>(fnv1a(absolute)));
+    name = "motwin-pty-link#" + std::string(hashed);
+  }
+  // sun_path[0] = 0: the abstract namespace.
+  std::memcpy(address.sun_path + 1, name.data(), name.size());
+  const auto length = static_cast<socklen_t>(offsetof(sockaddr_un, sun_path) + 1 + name.size());
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return Error{"cannot claim " + link_path + ": " + std::strerror(errno)};
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), length) != 0) {
+    const int error = errno;
+    ::close(fd);
+    if (error == EADDRINUSE) {
+      return Error{link_path + " is the serial port of a running motwin; not taking it over (stop that one or "
+                   "choose another path)"};
+    }
+    return Error{"cannot claim " + link_path + ": " + std::strerror(error)};
+  }
+  return fd;
+}
+
 Result<PtyDevice> open_pty_device(const std::string& link_path) {
-  auto fail = [](const std::string& what, int master_fd, int slave_fd) {
+  int claim_fd = -1;
+  auto fail = [&claim_fd](const std::string& what, int master_fd, int slave_fd) {
     if (slave_fd >= 0) ::close(slave_fd);
     if (master_fd >= 0) ::close(master_fd);
+    if (claim_fd >= 0) ::close(claim_fd);
     return Error{what};
   };
   if (link_path.empty()) return fail("the pseudo-terminal link path is empty", -1, -1);
+  Result<int> claim = claim_pty_link(link_path);
+  if (!claim) return fail(claim.error(), -1, -1);
+  claim_fd = *claim;
   const int master_fd = ::posix_openpt(O_RDWR | O_NOCTTY | O_CLOEXEC);
   if (master_fd < 0) return fail("cannot create a pseudo-terminal: " + std::string(std::strerror(errno)), -1, -1);
   char device[PATH_MAX];
@@ -88,7 +140,7 @@ Result<PtyDevice> open_pty_device(const std::string& link_path) {
                 slave_fd);
   }
   if (Result<void> linked = place_link(link_path, device); !linked) return fail(linked.error(), master_fd, slave_fd);
-  return PtyDevice{master_fd, slave_fd, device};
+  return PtyDevice{master_fd, slave_fd, claim_fd, device};
 }
 
 void remove_pty_link(const std::string& link_path, const std::string& device_path) {
@@ -113,6 +165,7 @@ PtyPort::PtyPort(EventLoop& loop, const PtyDevice& device, std::string link_path
     : loop_(loop),
       master_fd_(device.master_fd),
       slave_fd_(device.slave_fd),
+      link_claim_fd_(device.link_claim_fd),
       link_path_(std::move(link_path)),
       device_path_(device.device_path),
       max_pending_output_bytes_(max_pending_output_bytes),
@@ -127,6 +180,7 @@ PtyPort::~PtyPort() {
   remove_pty_link(link_path_, device_path_);
   ::close(slave_fd_);
   ::close(master_fd_);
+  if (link_claim_fd_ >= 0) ::close(link_claim_fd_);  // after the link is gone
 }
 
 void PtyPort::on_events(short revents) {

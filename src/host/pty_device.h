@@ -20,12 +20,19 @@ namespace motwin::host {
 struct PtyDevice {
   int master_fd = -1;
   int slave_fd = -1;
+  int link_claim_fd = -1;   // held while the link is ours (claim_pty_link)
   std::string device_path;  // /dev/pts/N
 };
 
-// Creates the pty and the link. An existing symbolic link is replaced when it is stale or points
-// into /dev/pts (left by an earlier run); anything else at `link_path` is an error. A failure
-// leaves nothing open.
+// Claims the link name for this process: an abstract Unix socket named after the link's absolute
+// path, which the kernel releases when the process ends however it ends (no file to go stale).
+// The descriptor to hold, or an error naming the link when another live process holds it.
+Result<int> claim_pty_link(const std::string& link_path);
+
+// Creates the pty and the link. A link that another live motwin process owns (claim_pty_link)
+// is refused. An existing symbolic link is otherwise replaced when it is stale or points into
+// /dev/pts (left by an earlier run, killed perhaps); anything else at `link_path` is an error.
+// A failure leaves nothing open.
 Result<PtyDevice> open_pty_device(const std::string& link_path);
 
 // Removes the link if it still points to `device_path` (another instance may own it now).
@@ -69,6 +76,7 @@ class PtyPort {
   EventLoop& loop_;
   int master_fd_;
   int slave_fd_;
+  int link_claim_fd_;
   std::string link_path_;
   std::string device_path_;
   size_t max_pending_output_bytes_;

@@ -227,6 +227,24 @@ TEST_F(PtyEndpointTest, a_regular_file_or_a_link_to_something_else_is_not_replac
   EXPECT_EQ(std::filesystem::read_symlink(link()).string(), target);
 }
 
+// A live server's link is never taken over (a killed one's is: a_stale_link_is_replaced...): the
+// claim is the name, however it is spelled, and it ends with its owner.
+TEST_F(PtyEndpointTest, a_link_a_live_endpoint_owns_is_refused_and_free_again_once_it_closes) {
+  open_endpoint();
+  const std::string device = endpoint_->device_path();
+  const std::string other_spelling = (scratch_.path() / "." / "tmcm1636").string();
+  Result<std::unique_ptr<TmclPtyEndpoint>> second =
+      TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), other_spelling);
+  ASSERT_FALSE(second);
+  EXPECT_EQ(second.error(), other_spelling + " is the serial port of a running motwin; not taking it over (stop that "
+                                             "one or choose another path)");
+  EXPECT_EQ(std::filesystem::read_symlink(link()).string(), device) << "the owner's link is untouched";
+  endpoint_.reset();
+  Result<std::unique_ptr<TmclPtyEndpoint>> after =
+      TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link());
+  ASSERT_TRUE(after) << after.error();
+}
+
 TEST_F(PtyEndpointTest, a_link_in_a_missing_directory_is_an_error) {
   Result<std::unique_ptr<TmclPtyEndpoint>> opened =
       TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), (scratch_.path() / "no" / "tty").string());
