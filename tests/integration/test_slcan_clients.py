@@ -30,7 +30,7 @@ from client_harness import (  # noqa: E402
     ANSWER_1000, SLCAN_UNIT_ENDS, UPLOAD_1000, Memory, UnitPty, Worker, is_slcan_frame, run_beside, sdo_1017_round,
     sdo_answer_of, slcan_answer, slcan_line, slcan_open, socketcand_client, socketcand_frame, write_and_read_some,
 )
-from motwin_harness import TempDir, check, check_equal, run_tests  # noqa: E402
+from motwin_harness import TempDir, TestFailure, check, check_equal, run_tests  # noqa: E402
 
 NODE = 5
 SLCAN_UPLOAD_1000 = slcan_line(0x600 + NODE, UPLOAD_1000) + "\r"
@@ -61,12 +61,25 @@ def is_transmit_ack(unit):
     return unit in ("z\r", "Z\r")
 
 
-def first_answer_after_open(c, after_transmits=False):
+def first_answer_after_open(c, after_transmits=False, server=None):
     """The first answer behind the stale frames and tails. `after_transmits`: the client sent
     transmit commands before it flushed, so whole acknowledgements may slip through the flush like
-    the frames do (seen on a loaded machine)."""
-    return c.read_until(lambda u: not is_slcan_frame(u) and not is_stale_tail(u)
-                        and not (after_transmits and is_transmit_ack(u)), what="SLCAN answer")
+    the frames do (seen on a loaded machine). A failure lists what was passed over and the end
+    of the server's stderr (once seen under heavy load: no answer at all, only heartbeats)."""
+    passed_over = []
+
+    def is_answer(unit):
+        if is_slcan_frame(unit) or is_stale_tail(unit) or (after_transmits and is_transmit_ack(unit)):
+            passed_over.append(unit)
+            return False
+        return True
+
+    try:
+        return c.read_until(is_answer, what="SLCAN answer")
+    except TestFailure as failure:
+        stderr = server.stderr_lines()[-5:] if server is not None else "not captured"
+        raise TestFailure(f"{failure}; passed over {len(passed_over)} units, the first {passed_over[:5]!r}, "
+                          f"the last {passed_over[-5:]!r}; server stderr ends {stderr!r}") from None
 
 
 def garbage_lines(rng, total):
@@ -212,7 +225,7 @@ def test_slcan_pty_flood(motwin):
                     check_equal(len(dropped), 1, f"log lines about dropped output ({server.stderr_lines()[-5:]})")
                     sleepy.flush_input()  # what pyserial does on open
                     sleepy.send("V\r")
-                    check_equal(first_answer_after_open(sleepy, after_transmits=True), "V1013\r", "first answer after the flush")
+                    check_equal(first_answer_after_open(sleepy, after_transmits=True, server=server), "V1013\r", "first answer after the flush")
                 finally:
                     sleepy.close()
                 print(f"  {FLOOD_REQUESTS} more from a client that never read: {dropped[0]}", flush=True)
