@@ -101,6 +101,17 @@ struct AxisConfig {
 
 enum class MotionMode : uint8_t { kVelocity, kPosition, kTorque };
 
+// The normalisation of the gains AP 70..74 (docs/tmcm-1636-servo.md "Gains and units", with the
+// evidence and the derivation in "Regulator scaling: evidence"). All loops run every 50 µs tick.
+// Current (AP 70/71): mV = P * e / 256 + I * sum(e) / 65536, e in mA.
+inline constexpr motion::PiScale kCurrentPiScale{1.0f / 256.0f, 1.0f / 65536.0f};
+// Velocity (AP 72/73): mA = P * e / 256 + I * sum(e) / 262144, e in rpm.
+inline constexpr motion::PiScale kVelocityPiScale{1.0f / 256.0f, 1.0f / 262144.0f};
+// Position (AP 74): rpm = P * e / 1024, e in 1/65536 revolution whatever AP 100 (or AP 56) counts,
+// so that one P means the same stiffness on a hall, ABN or absolute position.
+inline constexpr motion::PiScale kPositionPiScale{1.0f / 1024.0f, motion::kPiIntegralScale};  // no I (AP 74 only)
+inline constexpr double kPositionErrorUnitsPerRevolution = 65536.0;
+
 // AP 103 (manual table 11).
 enum class EncoderInitState : int32_t { kIdle = 0, kStartInit = 1, kWaitInitTime = 2, kEstimateOffset = 3 };
 

@@ -376,9 +376,12 @@ float Tmcm1636Axis::velocity_reference_rpm(double dt_s) {
     ramp_.set_state(ramp_.target_position(), 0.0);
   }
   if (state.mode == MotionMode::kPosition && !open_loop) {
-    const auto error =
+    const auto error_counts =
         static_cast<int32_t>(static_cast<uint32_t>(ramp_.position()) - static_cast<uint32_t>(state.actual_position));
-    velocity_rpm += motion::pi_apply(config.position_pi, state.position_pi, error, 1e9f);
+    // The regulator's unit: 1/65536 revolution (saturates far beyond where AP 43 clips the output).
+    const int32_t error = round_to_int32(static_cast<double>(error_counts) * kPositionErrorUnitsPerRevolution *
+                                         servo_.inverse_encoder_steps);
+    velocity_rpm += motion::pi_apply(config.position_pi, kPositionPiScale, state.position_pi, error, 1e9f);
   }
   const double limit = config.max_velocity_rpm;
   if (velocity_rpm > limit || velocity_rpm < -limit) {
@@ -525,7 +528,7 @@ void Tmcm1636Axis::velocity_mode_demand(bool open_loop, CurrentDemand& demand, d
   } else {
     const int32_t error = round_to_int32(velocity_ref - to_rpm(servo_.velocity_counts_per_s));
     demand.iq_ref =
-        motion::pi_apply(config.velocity_pi, state.velocity_pi, error, static_cast<float>(config.max_current_ma));
+        motion::pi_apply(config.velocity_pi, kVelocityPiScale, state.velocity_pi, error, static_cast<float>(config.max_current_ma));
     if (state.velocity_pi.limited) servo_.flags |= status_flag::kCurrentLimit;
     ++servo_.velocity_loops;
   }
@@ -552,7 +555,7 @@ void Tmcm1636Axis::regulate_dc_current(const CurrentDemand& demand, const PhaseC
                                        board::Tmcm1636Drive& drive) {
   state.actual_torque_ma = state.adc_phase_a;
   state.actual_flux_ma = 0;
-  const float volts_mv = motion::pi_apply(config.current_pi, state.torque_pi,
+  const float volts_mv = motion::pi_apply(config.current_pi, kCurrentPiScale, state.torque_pi,
                                           round_to_int32(demand.iq_ref - currents.a), supply_volts * 1000.0f);
   motion::pi_reset(state.flux_pi);
   if (state.torque_pi.limited) servo_.flags |= status_flag::kVoltageLimit;
@@ -571,7 +574,7 @@ void Tmcm1636Axis::regulate_foc_currents(const CurrentDemand& demand, const Phas
   state.actual_torque_ma = round_to_int32(measured.q);
   state.actual_flux_ma = round_to_int32(measured.d);
   const float limit_mv = motion::svm_voltage_limit(supply_volts) * 1000.0f;
-  motion::pi_apply_vector(config.current_pi, state.flux_pi, state.torque_pi, round_to_int32(demand.id_ref - measured.d),
+  motion::pi_apply_vector(config.current_pi, kCurrentPiScale, state.flux_pi, state.torque_pi, round_to_int32(demand.id_ref - measured.d),
                           round_to_int32(demand.iq_ref - measured.q), limit_mv);
   if (state.torque_pi.limited) servo_.flags |= status_flag::kVoltageLimit;
   // The advance is a few degrees: rotate the measurement angle's sin/cos by it.

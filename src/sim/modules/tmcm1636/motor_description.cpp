@@ -57,9 +57,9 @@ MotorDescription default_24v() {
   s.open_loop_current_ma = 1000;
   s.current_p = 461;  // current loop at 3000 rad/s: P = L w, I = R w (docs/tmcm-1636-servo.md)
   s.current_i = 3932;
-  s.velocity_p = 1200;
-  s.velocity_i = 1200;
-  s.position_p = 300;
+  s.velocity_p = 1200;  // velocity loop at about 340 rad/s, integral zero at 78 rad/s
+  s.velocity_i = 4800;
+  s.position_p = 75;  // position loop at 80 rad/s (1.07 rad/s per unit of P)
   m.startup = s;
   return m;
 }
@@ -114,8 +114,8 @@ MotorDescription large_48v() {
   s.current_p = 20;  // current loop at 5000 rad/s
   s.current_i = 639;
   s.velocity_p = 13100;
-  s.velocity_i = 6300;
-  s.position_p = 56;
+  s.velocity_i = 25200;
+  s.position_p = 28;  // position loop at 30 rad/s
   m.startup = s;
   return m;
 }
@@ -149,8 +149,8 @@ MotorDescription dc_24v() {
   s.current_p = 768;  // current loop at 3000 rad/s
   s.current_i = 19660;
   s.velocity_p = 1200;
-  s.velocity_i = 580;
-  s.position_p = 225;
+  s.velocity_i = 2320;
+  s.position_p = 28;  // position loop at 30 rad/s
   m.startup = s;
   return m;
 }
