@@ -69,6 +69,18 @@ TEST(PiRegulator, output_is_p_times_error_over_256_plus_i_times_sum_over_65536) 
   EXPECT_EQ(state.error, 5);
 }
 
+TEST(PiRegulator, a_scale_sets_what_one_unit_of_p_and_of_i_is_worth) {
+  const PiConfig config{1024, 262144};
+  const PiScale scale{1.0f / 1024.0f, 1.0f / 262144.0f};
+  PiState state;
+  EXPECT_FLOAT_EQ(pi_apply(config, scale, state, 10, 1e6f), 10.0f + 10.0f);
+  EXPECT_FLOAT_EQ(pi_apply(config, scale, state, 5, 1e6f), 5.0f + 15.0f);
+  // The bound on the integral term follows the scale: I * sum * scale stays within the limit.
+  for (int i = 0; i < 1000; ++i) pi_apply(config, scale, state, 10, 100.0f);
+  EXPECT_LE(static_cast<double>(config.i) * scale.integral * state.error_sum, 100.0 + 1e-3);
+  EXPECT_GT(static_cast<double>(config.i) * scale.integral * state.error_sum, 50.0);
+}
+
 TEST(PiRegulator, does_not_wind_up_while_limited) {
   const PiConfig config{256, 6554};
   PiState state;
