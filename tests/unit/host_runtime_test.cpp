@@ -35,8 +35,8 @@ MakeModuleResult make_quiet(ModuleOptions options = {}) {
 TEST(ModuleRegistry, knows_the_tmcm_1636_and_refuses_unknown_names) {
   EXPECT_EQ(module_names(), "tmcm-1636, tmcm-142, tmcm-3216");
   ASSERT_NE(find_module("tmcm-1636"), nullptr);
-  // 11 I/O signals (GPI0..REF_H) and 8 of the motor (LOAD_TORQUE..HALL_FAULT).
-  EXPECT_EQ(find_module("tmcm-1636")->input_signals().size(), 19u);
+  // 11 I/O signals (GPI0..REF_H) and 9 of the motor (LOAD_TORQUE..HALL_FAULT, REF_AT_LEVEL among them).
+  EXPECT_EQ(find_module("tmcm-1636")->input_signals().size(), 20u);
   const MakeModuleResult unknown = make_module("tmcm-9999", {});
   EXPECT_FALSE(unknown);
   EXPECT_EQ(unknown.error(), "unknown module \"tmcm-9999\" (available: tmcm-1636, tmcm-142, tmcm-3216)");

@@ -220,6 +220,37 @@ TEST(MotorDescription, errors_name_the_file_and_the_problem) {
   EXPECT_TRUE(resolve_motor("ideal").error().empty());
 }
 
+// "preset": a bench motor as a preset with what differs (here an absolute encoder mounted),
+// without copying the preset's figures.
+TEST(MotorDescription, a_file_can_start_from_a_preset) {
+  const MotorDescription preset = *motor_preset("qbl4208-61-04-013");
+  const Result<MotorDescription> parsed = parse_motor_description(
+      R"({"preset": "qbl4208-61-04-013", "absolute_encoder": {"bits": 12, "reversed": true},
+          "startup": {"position_sensor": "absolute_encoder"}, "axis_parameters": {"160": 1}})",
+      "amt20.json");
+  ASSERT_TRUE(parsed) << parsed.error();
+  EXPECT_EQ(parsed->name, "amt20.json");
+  EXPECT_EQ(parsed->kind, MotorKind::kBldc);
+  EXPECT_DOUBLE_EQ(parsed->torque_constant(), preset.torque_constant());
+  EXPECT_DOUBLE_EQ(parsed->resistance_ohm, preset.resistance_ohm);
+  EXPECT_EQ(parsed->hall.inverted, preset.hall.inverted);
+  EXPECT_EQ(parsed->abn.reversed, preset.abn.reversed);
+  EXPECT_TRUE(parsed->absolute.present);
+  EXPECT_EQ(parsed->absolute.bits, 12);
+  EXPECT_TRUE(parsed->absolute.reversed);
+  ASSERT_TRUE(parsed->startup);
+  EXPECT_EQ(parsed->startup->position_sensor, PositionSensor::kAbsoluteEncoder);
+  EXPECT_EQ(parsed->startup->current_i, preset.startup->current_i) << "the other start-up settings stay";
+  EXPECT_EQ(parsed->startup->hall_polarity_inverted, preset.startup->hall_polarity_inverted);
+  const std::vector<std::pair<uint8_t, int32_t>> parameters{{160, 1}};
+  EXPECT_EQ(parsed->axis_parameters, parameters);
+  const Result<MotorDescription> dc = parse_motor_description(R"({"preset": "dc-24v", "resistance_ohm": 3})", "d.json");
+  ASSERT_TRUE(dc) << dc.error();
+  EXPECT_EQ(dc->kind, MotorKind::kDc);
+  EXPECT_DOUBLE_EQ(dc->torque_constant(), motor_preset("dc-24v")->torque_constant());
+  EXPECT_EQ(parse_motor_description(R"({"preset": "qbl"})", "u.json").error(), "u.json: unknown preset \"qbl\"");
+}
+
 // Start-up settings are named values in the motor's units; numbered firmware parameters are
 // kept as given unless the caller checks them for its firmware (the host does).
 TEST(MotorDescription, startup_settings_are_named_values_of_the_file) {
@@ -269,7 +300,7 @@ TEST(MotorDescription, startup_parameters_go_into_a_fresh_image) {
 TEST(Tmcm1636SimBoard, motor_signals_reach_the_plant_and_switches_follow_the_rotor) {
   Tmcm1636SimIo io;
   Tmcm1636SimBoard board(io, frictionless());
-  EXPECT_EQ(board.input_signals().size(), Tmcm1636SimIo::signal_table().size() + 8);
+  EXPECT_EQ(board.input_signals().size(), Tmcm1636SimIo::signal_table().size() + 9);
   board.set_input("LOAD_TORQUE", -0.02);
   board.set_input("REF_R_AT", 0.5);
   EXPECT_EQ(board.read_signal("LOAD_TORQUE"), -0.02);
@@ -287,6 +318,24 @@ TEST(Tmcm1636SimBoard, motor_signals_reach_the_plant_and_switches_follow_the_rot
   // VSUPPLY stays the source voltage; ADC_VM reads the bus.
   board.set_input("VSUPPLY", 30);
   EXPECT_EQ(board.read_signal("VSUPPLY"), 30.0);
+}
+
+// REF_AT_LEVEL 0: switches placed on the rotor's path pull their inputs low when pressed and
+// read high elsewhere, the wiring of low-active switches (AP 210 bit = 0).
+TEST(Tmcm1636SimBoard, switches_at_positions_can_pull_their_inputs_low) {
+  Tmcm1636SimIo io;
+  Tmcm1636SimBoard board(io, frictionless());
+  board.set_input("REF_AT_LEVEL", 0);
+  board.set_input("REF_L_AT", 100.0);  // pressed: the rotor is below
+  board.set_input("REF_R_AT", 100.0);  // free: the rotor has not reached it
+  board.before_tick();
+  EXPECT_EQ(board.read_signal("REF_AT_LEVEL"), 0.0);
+  EXPECT_FALSE(io.reference_switch_level(board::ReferenceSwitch::kLeft));
+  EXPECT_TRUE(io.reference_switch_level(board::ReferenceSwitch::kRight));
+  EXPECT_EQ(board.power_stage()->feedback.reference_switches & 3, 1);
+  board.set_input("REF_AT_LEVEL", 1);
+  board.before_tick();
+  EXPECT_EQ(board.power_stage()->feedback.reference_switches & 3, 2);
 }
 
 TEST(Tmcm1636SimBoard, the_ideal_motor_accepts_the_motor_signals_without_effect) {

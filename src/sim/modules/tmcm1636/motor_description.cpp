@@ -403,7 +403,7 @@ void read_startup(Reader& parent, std::optional<StartupSettings>& out) {
   const Json* section = parent.find("startup");
   if (section == nullptr || !parent.ok()) return;
   if (!section->is_object()) return parent.fail("startup must be an object");
-  StartupSettings settings;
+  StartupSettings settings = out.value_or(StartupSettings{});  // a preset's, changed key by key
   Reader reader{*section, "startup", parent.error};
   for (const StartupField& field : kStartupFields) {
     if (!reader.ok()) return;
@@ -459,23 +459,28 @@ OrderedJson startup_json(const StartupSettings& settings) {
 void read_kind(Reader& top, MotorDescription& m) {
   std::string kind = "bldc";
   top.text("type", kind);
+  if (top.find("type") == nullptr) return;  // a preset's kind stays (a new description is BLDC)
   if (kind == "dc") {
     m.kind = MotorKind::kDc;
     m.hall.present = false;
-  } else if (kind != "bldc") {
+  } else if (kind == "bldc") {
+    m.kind = MotorKind::kBldc;
+  } else {
     top.fail("type must be \"bldc\" or \"dc\", got \"" + kind + "\"");
   }
 }
 
 // The magnet strength, in whichever form the datasheet gives it: a DC motor's torque constant,
-// or a BLDC motor's flux linkage, torque constant or KV. After "type" and "pole_pairs".
-void read_magnet_strength(Reader& top, MotorDescription& m) {
+// or a BLDC motor's flux linkage, torque constant or KV. After "type" and "pole_pairs". A preset's
+// stays when the file gives none.
+void read_magnet_strength(Reader& top, MotorDescription& m, bool from_preset) {
   double flux = -1.0;
   double kt = -1.0;
   double kv = -1.0;
   top.number("flux_linkage_wb", flux, 1e-6, 10.0);
   top.number("torque_constant_nm_per_a", kt, 1e-5, 100.0);
   top.number("kv_rpm_per_v", kv, 0.1, 1e5);
+  if (from_preset && flux <= 0.0 && kt <= 0.0 && kv <= 0.0) return;
   if (m.kind == MotorKind::kDc) {
     if (kt <= 0.0) top.fail("a DC motor needs torque_constant_nm_per_a");
     m.torque_constant_nm_per_a = kt;
@@ -563,6 +568,16 @@ Result<MotorDescription> parse_motor_description(std::string_view json_text, std
   MotorDescription m;
   std::string error;
   Reader top{document, "", error};
+  // "preset": the description starts from that preset and the other keys change it (a motor of
+  // the bench with one sensor more, another supply), so the preset's figures are not copied.
+  std::string preset_name;
+  top.text("preset", preset_name);
+  if (!preset_name.empty()) {
+    std::optional<MotorDescription> preset = motor_preset(preset_name);
+    if (!preset) return Error{prefix + "unknown preset \"" + preset_name + "\""};
+    m = std::move(*preset);
+    m.name.clear();
+  }
   top.text("name", m.name);
   top.text("source", m.source);
   read_kind(top, m);
@@ -571,7 +586,7 @@ Result<MotorDescription> parse_motor_description(std::string_view json_text, std
   double inductance = -1.0;
   top.number("inductance_h", inductance, 1e-7, 1.0);
   if (inductance > 0.0) m.inductance_d_h = m.inductance_q_h = inductance;
-  read_magnet_strength(top, m);
+  read_magnet_strength(top, m, !preset_name.empty());
   read_fields<MotorDescription>(top, m, kMotorFields);
   read_section<Hall>(top, "hall", m.hall, kHallFields);
   read_section<Abn>(top, "abn_encoder", m.abn, kAbnFields);
@@ -579,7 +594,15 @@ Result<MotorDescription> parse_motor_description(std::string_view json_text, std
   read_section<Brake>(top, "brake", m.brake, kBrakeFields);
   read_section<Supply>(top, "supply", m.supply, kSupplyFields);
   read_startup(top, m.startup);
-  read_axis_parameters(top, check, m.axis_parameters);
+  std::vector<std::pair<uint8_t, int32_t>> listed;
+  read_axis_parameters(top, check, listed);
+  // A preset's own entries stay unless the file gives the same number.
+  std::erase_if(m.axis_parameters, [&listed](const auto& kept) {
+    return std::any_of(listed.begin(), listed.end(), [&kept](const auto& entry) { return entry.first == kept.first; });
+  });
+  m.axis_parameters.insert(m.axis_parameters.end(), listed.begin(), listed.end());
+  std::stable_sort(m.axis_parameters.begin(), m.axis_parameters.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
   if (top.ok()) top.finish();
   if (!error.empty()) return Error{prefix + error};
   if (m.name.empty()) m.name = std::string(source_name);

@@ -9,7 +9,8 @@
 // are named values, and the host writes them into the firmware's image through the module's
 // parameter table (src/host/modules/tmcm1636/tmcm1636_startup_image.*). A description file may
 // also give firmware axis parameters by number ("axis_parameters"): the motor keeps them as
-// given, and the caller that knows the firmware checks them (AxisParameterCheck).
+// given, and the caller that knows the firmware checks them (AxisParameterCheck). A file may
+// start from a preset ("preset": name) and change it key by key.
 #pragma once
 
 #include <cstddef>

@@ -14,11 +14,22 @@ constexpr SignalInfo kMotorSignals[] = {
     {"REF_R_AT", -1e6, 1e6, false, "right switch active at rotor positions >= this, revolutions (physical motor)"},
     {"REF_L_AT", -1e6, 1e6, false, "left switch active at rotor positions <= this, revolutions (physical motor)"},
     {"REF_H_AT", -1e6, 1e6, false, "home switch active at rotor positions >= this, revolutions (physical motor)"},
+    {"REF_AT_LEVEL", 0, 1, true, "input level of a REF_*_AT switch while the rotor is past it, the other elsewhere (default 1)"},
     {"ENCODER_FAULT", 0, 1, true, "1 freezes the ABN encoder: lost A/B/N signals (physical motor)"},
     {"HALL_FAULT", 0, 1, true, "1 makes the hall inputs read 000: lost hall supply (physical motor)"},
 };
 
-enum MotorSignal : size_t { kLoadTorque, kLoadInertia, kBlocked, kRefRightAt, kRefLeftAt, kRefHomeAt, kEncoderFault, kHallFault };
+enum MotorSignal : size_t {
+  kLoadTorque,
+  kLoadInertia,
+  kBlocked,
+  kRefRightAt,
+  kRefLeftAt,
+  kRefHomeAt,
+  kRefAtLevel,
+  kEncoderFault,
+  kHallFault
+};
 
 }  // namespace
 
@@ -53,6 +64,7 @@ void Tmcm1636SimBoard::set_input(std::string_view name, double value) {
     case kRefRightAt: switch_at_revolutions_[0] = value; break;
     case kRefLeftAt: switch_at_revolutions_[1] = value; break;
     case kRefHomeAt: switch_at_revolutions_[2] = value; break;
+    case kRefAtLevel: switch_at_pressed_level_ = value != 0; break;
     case kEncoderFault: encoder_fault_ = value != 0; break;
     case kHallFault: hall_fault_ = value != 0; break;
   }
@@ -74,6 +86,7 @@ std::optional<double> Tmcm1636SimBoard::read_signal(std::string_view name) const
       case kRefRightAt: return switch_at_revolutions_[0];
       case kRefLeftAt: return switch_at_revolutions_[1];
       case kRefHomeAt: return switch_at_revolutions_[2];
+      case kRefAtLevel: return switch_at_pressed_level_ ? 1.0 : 0.0;
       case kEncoderFault: return encoder_fault_ ? 1.0 : 0.0;
       case kHallFault: return hall_fault_ ? 1.0 : 0.0;
     }
@@ -98,9 +111,12 @@ void Tmcm1636SimBoard::sense() {
   p.set_source_voltage(io_.supply_millivolt() / 1000.0);
   p.set_ambient_celsius(io_.temperature_celsius());
   const double position = p.position_revolutions();
-  if (switch_at_revolutions_[0]) io_.set_reference_switch_level(ReferenceSwitch::kRight, position >= *switch_at_revolutions_[0]);
-  if (switch_at_revolutions_[1]) io_.set_reference_switch_level(ReferenceSwitch::kLeft, position <= *switch_at_revolutions_[1]);
-  if (switch_at_revolutions_[2]) io_.set_reference_switch_level(ReferenceSwitch::kHome, position >= *switch_at_revolutions_[2]);
+  const auto place = [&](ReferenceSwitch which, bool pressed) {
+    io_.set_reference_switch_level(which, pressed == switch_at_pressed_level_);
+  };
+  if (switch_at_revolutions_[0]) place(ReferenceSwitch::kRight, position >= *switch_at_revolutions_[0]);
+  if (switch_at_revolutions_[1]) place(ReferenceSwitch::kLeft, position <= *switch_at_revolutions_[1]);
+  if (switch_at_revolutions_[2]) place(ReferenceSwitch::kHome, position >= *switch_at_revolutions_[2]);
   p.sense(stage_.feedback);
   uint8_t levels = 0;
   if (io_.reference_switch_level(ReferenceSwitch::kRight)) levels |= 1;

@@ -60,6 +60,9 @@ class Tmcm1636SimBoard final : public SimBoardOverIo<Tmcm1636SimBoard, Tmcm1636S
   board::Tmcm1636PowerStage stage_{};
   // Reference switches driven by the rotor position (REF_R_AT ...): right, left, home.
   std::array<std::optional<double>, 3> switch_at_revolutions_{};
+  // The level those switches give while the rotor is past them (REF_AT_LEVEL); the other level
+  // elsewhere. 0 is a switch that pulls its input low when pressed, as AP 210 = 0 expects.
+  bool switch_at_pressed_level_ = true;
   double load_torque_ = 0.0;
   double load_inertia_ = 0.0;
   bool blocked_ = false;
