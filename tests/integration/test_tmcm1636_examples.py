@@ -74,8 +74,9 @@ def move_to(c, target):
 
 def wait_position_reached(c, target, budget_ms):
     """The scripts' loop: GAP 55 until it is set, reading AP 50 and AP 52 every 0.2 s (here of
-    simulated time), for at most `budget_ms` of simulated time; then the position is checked
-    against AP 53."""
+    simulated time), for at most `budget_ms` of simulated time. Then the motor must hold the
+    target: half a second later AP 55 is still set and AP 52 within AP 53 of it (the flag alone
+    may catch a motor passing through the window, slower than AP 54)."""
     deadline_ms = sim_ms(c) + budget_ms
     positions = []
     while not c.gap(POSITION_REACHED):
@@ -85,6 +86,8 @@ def wait_position_reached(c, target, budget_ms):
             raise TestFailure(f"AP 55 not set within {budget_ms} ms of simulated time moving to {target}; "
                               f"the last positions {positions[-10:]}")
         c.wait_sim_ms(200)
+    c.wait_sim_ms(500)
+    check_equal(c.gap(POSITION_REACHED), 1, f"AP 55 half a second after it was set at {target}")
     position = c.gap(ACTUAL_POSITION)
     distance = c.gap(REACHED_DISTANCE)
     check(abs(position - target) <= distance, f"AP 52 {position} within AP 53 ({distance}) of {target}")
@@ -164,7 +167,7 @@ def test_tmcl_script_load(motwin):
 # The examples' gains: torque P/I, velocity P/I, position P.
 EXAMPLE_GAINS = ((70, 300), (71, 600), (72, 100), (73, 100), (74, 300))
 HALL_AS_WIRED = ((91, 0), (90, 1), (93, 0), (92, 1))  # direction, polarity 1, offset, interpolation
-# The position examples finish in about 5 s of simulated time; --speed 4 shortens the wait.
+# The position examples take up to 19 s of simulated time; --speed 4 shortens the wait.
 FASTER = ["--speed", "4"]
 
 
