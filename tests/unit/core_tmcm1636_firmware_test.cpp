@@ -157,8 +157,13 @@ TEST(Tmcm1636Firmware, a_firmware_update_gives_the_new_rows_their_defaults_and_k
   EXPECT_EQ(slot(kLayout.axis_parameter(0, 56)), 65536);  // 1.09 has no AP 56: the slot is kept
 }
 
+// AP 56 = AP 100 (8192, the factory encoder steps): the host counts as the axis does, so that
+// these tests see the direction alone (the scaler: ap56_...).
+void count_positions_as_the_axis(Tmcm1636Rig& rig) { ASSERT_EQ(rig.command(kSap, 56, 0, 8192).status, kOk); }
+
 TEST(Tmcm1636Firmware, ap13_inverts_the_motion_of_the_ideal_motor) {
   Tmcm1636Rig rig(Firmware::kV113);
+  count_positions_as_the_axis(rig);
   ASSERT_EQ(rig.command(kSap, 13, 0, 1).status, kOk);
   ASSERT_EQ(rig.command(1, 0, 0, 1000).status, kOk);  // ROR 1000
   rig.run_ms(1000);
@@ -195,11 +200,58 @@ TEST(Tmcm1636Firmware, ap13_inverts_the_motion_of_the_ideal_motor) {
 
 TEST(Tmcm1636Firmware, ap13_at_0_leaves_the_motion_as_on_1_09) {
   Tmcm1636Rig rig(Firmware::kV113);
+  count_positions_as_the_axis(rig);
   ASSERT_EQ(rig.command(1, 0, 0, 1000).status, kOk);
   rig.run_ms(1000);
   EXPECT_EQ(rig.gap(42), 1000);
   EXPECT_EQ(rig.module.axis().state.actual_velocity_rpm, 1000);
   EXPECT_EQ(rig.module.axis().state.actual_position, rig.gap(52));
+}
+
+// AP 56 (docs/tmcm-1636.md "Firmware generations"): the host's positions count AP 56 per
+// revolution, the axis AP 100, whatever the sensor; AP 53 is in the host's counts too. The
+// factory values (65536 and 8192) make one host count an eighth of an encoder count.
+TEST(Tmcm1636Firmware, ap56_scales_the_positions_the_host_sees_and_commands) {
+  Tmcm1636Rig rig(Firmware::kV113);
+  ASSERT_EQ(rig.command(4, 0, 0, 65536).status, kOk);  // MVP ABS: one revolution
+  rig.run_ms(3000);
+  EXPECT_EQ(rig.module.axis().state.actual_position, 8192);
+  EXPECT_EQ(rig.gap(50), 65536);
+  EXPECT_EQ(rig.gap(52), 65536);
+  EXPECT_EQ(rig.gap(55), 1);
+  ASSERT_EQ(rig.command(4, 1, 0, -32768).status, kOk);  // MVP REL: half a revolution back
+  EXPECT_EQ(rig.gap(50), 32768);
+  rig.run_ms(2000);
+  EXPECT_EQ(rig.module.axis().state.actual_position, 4096);
+
+  // The examples' setting: hall steps per revolution on a 4096-count encoder (a host count is
+  // 170.67 encoder counts), MVP 4000 as hall_position_mode sends it.
+  ASSERT_EQ(rig.command(kSap, 100, 0, 4096).status, kOk);
+  ASSERT_EQ(rig.command(kSap, 56, 0, 24).status, kOk);
+  ASSERT_EQ(rig.command(kSap, 52, 0, 0).status, kOk);
+  EXPECT_EQ(rig.module.axis().state.actual_position, 0);
+  ASSERT_EQ(rig.command(4, 0, 0, 4000).status, kOk);
+  EXPECT_EQ(rig.module.axis().target_position(), 682667);  // 4000 * 4096 / 24, rounded
+  rig.run_ms(12000);  // 166.7 revolutions at AP 43's 2000 rpm (factory ramp)
+  EXPECT_EQ(rig.gap(52), 4000);
+  EXPECT_EQ(rig.gap(55), 1);
+  // AP 53 = 1 host count (the factory 5 would be 853 encoder counts): a target one host count
+  // away (170 encoder counts) is within it, two (341) are not. The ideal motor updates AP 55 as
+  // the target is written.
+  ASSERT_EQ(rig.command(kSap, 53, 0, 1).status, kOk);
+  ASSERT_EQ(rig.command(kSap, 50, 0, 4001).status, kOk);
+  EXPECT_EQ(rig.module.axis().target_position(), 682837);
+  EXPECT_EQ(rig.gap(55), 1);
+  ASSERT_EQ(rig.command(kSap, 50, 0, 4002).status, kOk);
+  EXPECT_EQ(rig.gap(55), 0);
+}
+
+TEST(Tmcm1636Firmware, positions_on_1_09_are_the_axis_counts_whatever_ap56_would_say) {
+  Tmcm1636Rig rig;  // 1.09: no AP 56
+  ASSERT_EQ(rig.command(4, 0, 0, 65536).status, kOk);
+  rig.run_ms(9000);
+  EXPECT_EQ(rig.module.axis().state.actual_position, 65536);
+  EXPECT_EQ(rig.gap(52), 65536);
 }
 
 }  // namespace

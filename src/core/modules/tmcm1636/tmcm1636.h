@@ -66,7 +66,9 @@ inline constexpr tmcl::ModuleFacts kFacts{
 class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts> {
  public:
   Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io, Firmware firmware = Firmware::kV109)
-      : TmclModule(nvm, io), firmware_(firmware), axis_table_(&axis_parameters(firmware)) {}
+      : TmclModule(nvm, io), firmware_(firmware), axis_table_(&axis_parameters(firmware)) {
+    axis().set_position_scaler_applies(firmware == Firmware::kV113);
+  }
 
   // Firmware 1.09's axis parameters (manual table 11), and those of a generation.
   static const Table& axis_parameters() { return axis_parameters(Firmware::kV109); }
@@ -82,10 +84,12 @@ class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalCon
   const Table& axis_table() const { return *axis_table_; }
   // TmclDevice: command 136 of this generation.
   const tmcl::FirmwareIdentity& identity() const override { return identity_of(firmware_); }
-  // tmcl::TmclModule hook: MVP REL adds to the position as AP 52 reads it (AP 13 inverts it).
-  int32_t host_actual_position() const {
-    const int32_t position = axis().actual_position();
-    return axis().config.motor_direction != 0 ? static_cast<int32_t>(0u - static_cast<uint32_t>(position)) : position;
+  // tmcl::TmclModule hook: MVP REL adds to the position as AP 52 reads it (on 1.13 in the host's
+  // direction, AP 13, and units, AP 56).
+  int32_t host_actual_position() {
+    int32_t position = 0;
+    (void)axis_table().read(*this, 0, 52, position);
+    return position;
   }
 
   // tmcl::TmclModule hook: one 50 µs control tick of the axis.

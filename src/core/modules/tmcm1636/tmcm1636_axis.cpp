@@ -163,6 +163,42 @@ void Tmcm1636Axis::ideal_tick(const board::Tmcm1636Io& io, double dt_s) {
   state.status_flags = flags;
 }
 
+namespace {
+
+// value * numerator / denominator, rounded to the nearest integer (halves away from zero), kept to
+// 32 bits as the position counter wraps.
+int32_t rescale(int32_t value, int64_t numerator, int64_t denominator) {
+  const int64_t product = static_cast<int64_t>(value) * numerator;
+  const int64_t half = denominator / 2;
+  const int64_t quotient = (product >= 0 ? product + half : product - half) / denominator;
+  return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(quotient)));
+}
+
+}  // namespace
+
+int32_t Tmcm1636Axis::host_position(int32_t axis_counts) const {
+  if (!position_scaler_applies_ || config.encoder_steps <= 0 || config.position_scaler == config.encoder_steps) {
+    return axis_counts;
+  }
+  return rescale(axis_counts, config.position_scaler, config.encoder_steps);
+}
+
+int32_t Tmcm1636Axis::axis_position(int32_t host_counts) const {
+  if (!position_scaler_applies_ || config.encoder_steps <= 0 || config.position_scaler == config.encoder_steps) {
+    return host_counts;
+  }
+  return rescale(host_counts, config.encoder_steps, config.position_scaler);
+}
+
+// AP 53 in the axis' counts: the host gives it in its own (AP 56 on firmware 1.13).
+double Tmcm1636Axis::position_reached_distance_counts() const {
+  if (!position_scaler_applies_ || config.encoder_steps <= 0 || config.position_scaler <= 0) {
+    return static_cast<double>(config.position_reached_distance);
+  }
+  return static_cast<double>(config.position_reached_distance) * static_cast<double>(config.encoder_steps) /
+         static_cast<double>(config.position_scaler);
+}
+
 // AP 55: |target - actual| <= AP 53 and |actual velocity| <= AP 54.
 void Tmcm1636Axis::update_position_reached() {
   if (power_stage_ != nullptr) {
@@ -170,7 +206,7 @@ void Tmcm1636Axis::update_position_reached() {
     return;
   }
   const double distance = std::fabs(ramp_.distance_to_target());
-  const bool near = distance <= static_cast<double>(config.position_reached_distance);
+  const bool near = distance <= position_reached_distance_counts();
   const bool slow = std::abs(state.actual_velocity_rpm) <= config.position_reached_velocity_rpm;
   state.position_reached = near && slow ? 1 : 0;
 }
@@ -179,7 +215,7 @@ void Tmcm1636Axis::update_position_reached_servo() {
   const auto distance =
       static_cast<int32_t>(static_cast<uint32_t>(ramp_.target_position()) - static_cast<uint32_t>(state.actual_position));
   const int64_t magnitude = distance < 0 ? -static_cast<int64_t>(distance) : distance;
-  const bool near = magnitude <= config.position_reached_distance;
+  const bool near = static_cast<double>(magnitude) <= position_reached_distance_counts();
   const bool slow = std::abs(state.actual_velocity_rpm) <= config.position_reached_velocity_rpm;
   state.position_reached = near && slow ? 1 : 0;
 }

@@ -63,7 +63,7 @@ struct AxisConfig {
   int32_t velocity_ramp_enabled = 1;         // AP 45
   int32_t position_reached_distance = 5;     // AP 53, position counts
   int32_t position_reached_velocity_rpm = 500;  // AP 54
-  int32_t position_scaler = 65536;           // AP 56 (1.13), stored only
+  int32_t position_scaler = 65536;           // AP 56 (1.13): the host's position counts per revolution
   motion::PiConfig current_pi;               // AP 70 (P), 71 (I): torque and flux regulators
   motion::PiConfig velocity_pi;              // AP 72, 73
   motion::PiConfig position_pi;              // AP 74 (P only; I stays 0)
@@ -210,6 +210,15 @@ class Tmcm1636Axis {
   void attach_power_stage(board::Tmcm1636PowerStage* stage) { power_stage_ = stage; }
   bool has_power_stage() const { return power_stage_ != nullptr; }
 
+  // Firmware 1.13: the host counts positions (AP 50..53, MVP) AP 56 per revolution; the axis
+  // keeps counting AP 100 per revolution (docs/tmcm-1636.md "Firmware generations"). Firmware,
+  // not a setting: it survives reset_state().
+  void set_position_scaler_applies(bool applies) { position_scaler_applies_ = applies; }
+  // A position in the host's counts from the axis' counts and back, rounded to the nearest count;
+  // the identity without the scaler or while AP 56 equals AP 100 (or AP 100 is 0).
+  int32_t host_position(int32_t axis_counts) const;
+  int32_t axis_position(int32_t host_counts) const;
+
   // One control tick of `dt_s` seconds: the ideal motor, or the regulators on the power stage.
   void tick(const board::Tmcm1636Io& io, double dt_s);
 
@@ -326,6 +335,7 @@ class Tmcm1636Axis {
   inline void count_loops();
   inline uint32_t servo_status_flags(bool bridge) const;
   void update_switches(uint8_t levels);
+  double position_reached_distance_counts() const;
   void update_position_reached();
   void update_position_reached_servo();
   void read_sensors(const board::Tmcm1636Feedback& feedback, double dt_s);
@@ -358,6 +368,7 @@ class Tmcm1636Axis {
   double rpm_per_count_per_s_ = 60.0 / 8192.0;
   double counts_per_s_per_rpm_ = 8192.0 / 60.0;
   board::Tmcm1636PowerStage* power_stage_ = nullptr;
+  bool position_scaler_applies_ = false;
   // Set by reset_state(), cleared by the first tick: parameter writes in between are the
   // power-up restore, not host commands.
   bool restoring_ = false;

@@ -64,6 +64,20 @@ constexpr Binding<Tmcm1636> host_frame() {
   return binding;
 }
 
+// Firmware 1.13's positions (AP 50, 51, 52): the host's frame is also scaled to AP 56 counts per
+// revolution (Tmcm1636Axis::host_position).
+template <const Binding<Tmcm1636>& kMotorFrame, bool kWritable>
+constexpr Binding<Tmcm1636> host_position_frame() {
+  Binding<Tmcm1636> binding;
+  binding.get = [](Tmcm1636& m, uint8_t axis) { return directed(m, m.axis().host_position(kMotorFrame.get(m, axis))); };
+  if constexpr (kWritable) {
+    binding.set = [](Tmcm1636& m, uint8_t axis, int32_t value) {
+      return kMotorFrame.set(m, axis, m.axis().axis_position(directed(m, value)));
+    };
+  }
+  return binding;
+}
+
 }  // namespace
 
 // Manual table 11. The bindings (config_field, state_value, axis_command ...) are those of
@@ -187,13 +201,13 @@ const Tmcm1636::Table& Tmcm1636::axis_parameters(Firmware firmware) {
   static constexpr params::ReboundRow<Tmcm1636> kReboundIn113[] = {
     {30, host_frame<kTargetTorque, true>()}, {31, host_frame<kActualTorque, false>()},
     {40, host_frame<kTargetVelocity, true>()}, {41, host_frame<kRampVelocity, false>()},
-    {42, host_frame<kActualVelocity, false>()}, {50, host_frame<kTargetPosition, true>()},
-    {51, host_frame<kRampPosition, false>()}, {52, host_frame<kActualPosition, true>()},
+    {42, host_frame<kActualVelocity, false>()}, {50, host_position_frame<kTargetPosition, true>()},
+    {51, host_position_frame<kRampPosition, false>()}, {52, host_position_frame<kActualPosition, true>()},
   };
   static constexpr Row kAddedIn113[] = {
     {{13, "motor direction", 0, 1, 0, access("RWEX"), Unit::kNone, "0 standard, 1 inverted: the motor turns the other way; AP 30, 31, 40..42, 50..52 change sign between host and motor"}, config_field<&AxisConfig::motor_direction>()},
     {{26, "velocity sensor selection", 0, 2, 0, access("RWEX"), Unit::kNone, "Velocity source: 0 same as commutation, 1 ABN encoder, 2 absolute encoder (stored only: the velocity comes from the position source, AP 25)"}, config_field<&AxisConfig::velocity_sensor_selection>()},
-    {{56, "position scaler", 1, 16777215, 65536, access("RWEX"), Unit::kNone, "Position counts per revolution for position units (stored only: positions stay in AP 100 counts)"}, config_field<&AxisConfig::position_scaler>()},
+    {{56, "position scaler", 1, 16777215, 65536, access("RWEX"), Unit::kNone, "Position counts per revolution of AP 50..53 and MVP, whatever the sensor"}, config_field<&AxisConfig::position_scaler>()},
     {{94, "hall sensor inputs", 0, 7, 0, access("R"), Unit::kNone, "Hall input levels: bit 0 H1, bit 1 H2, bit 2 H3"}, axis_value<&Tmcm1636Axis::hall_inputs>()},
     {{109, "encoder inputs", 0, 7, 0, access("R"), Unit::kNone, "ABN encoder input levels: bit 0 A, bit 1 B, bit 2 N (N reads 0)"}, axis_value<&Tmcm1636Axis::encoder_inputs>()},
     {{165, "absolute encoder data length", 1, 32, 16, access("RWEX"), Unit::kNone, "Bits per absolute encoder transfer (stored only)"}, config_field<&AxisConfig::absolute_encoder_data_length>()},
