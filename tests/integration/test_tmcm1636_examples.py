@@ -281,7 +281,8 @@ def check_stopped_at_switch(c, number, flag, what):
     velocity = c.gap(ACTUAL_VELOCITY)
     check(abs(velocity) <= 5, f"actual velocity {velocity} rpm at the {what} switch")
     position = c.gap(ACTUAL_POSITION)
-    check(abs(position - resting) <= 10, f"the motor stays at the {what} switch: AP 52 {resting}, then {position}")
+    tolerance = 10 * c.gap(56) / 4096  # 10 encoder counts in AP 52's units (AP 56 per revolution)
+    check(abs(position - resting) <= tolerance, f"the motor stays at the {what} switch: AP 52 {resting}, then {position}")
     check_equal(c.gap(number), 1, f"AP {number} ({what} switch) while the motor rests on it")
     check(c.gap(STATUS_FLAGS) & flag, f"AP 156 says the {what} switch stops the motion")
     return position
@@ -306,15 +307,20 @@ def test_hall_endstop(motwin):
                 expect_reply(c.request(ROR, 0, 0, 500), ROR, STATUS_OK, what="ROR 500")
                 wait_switch(c, RIGHT_SWITCH, budget_ms=5000)
                 right = check_stopped_at_switch(c, RIGHT_SWITCH, RIGHT_SWITCH_STOP, "right")
-                # AP 52 counts from the power-up angle of the rotor (40 degrees, 455 counts of
-                # AP 100 = 4096): the switch at 3 revolutions is 3 x 4096 - 455 counts away.
-                switch_counts = 3 * 4096 - 455
-                check(0 <= right - start - switch_counts <= 200, f"stopped at AP 52 {right}, past the switch at {switch_counts}")
+                # AP 52 counts AP 56 per revolution (the script leaves the factory 65536) from the
+                # power-up angle of the rotor (40 degrees, 455 of 4096 encoder counts): the switch
+                # at 3 revolutions is (3 x 4096 - 455) encoder counts away; stopping within 200
+                # encoder counts past it.
+                per_count = c.gap(56) / 4096
+                switch_counts = (3 * 4096 - 455) * per_count
+                check(0 <= right - start - switch_counts <= 200 * per_count,
+                      f"stopped at AP 52 {right}, past the switch at {switch_counts}")
                 expect_reply(c.request(ROR, 0, 0, -500), ROR, STATUS_OK, what="ROR -500")
                 wait_switch(c, LEFT_SWITCH, budget_ms=5000)
                 left = check_stopped_at_switch(c, LEFT_SWITCH, LEFT_SWITCH_STOP, "left")
-                switch_counts = -3 * 4096 - 455
-                check(0 <= switch_counts - (left - start) <= 200, f"stopped at AP 52 {left}, past the switch at {switch_counts}")
+                switch_counts = (-3 * 4096 - 455) * per_count
+                check(0 <= switch_counts - (left - start) <= 200 * per_count,
+                      f"stopped at AP 52 {left}, past the switch at {switch_counts}")
                 check_equal(c.gap(RIGHT_SWITCH), 0, "AP 211 (right switch) released on the way back")
                 expect_reply(c.request(ROR, 0, 0, 0), ROR, STATUS_OK, what="ROR 0")
             server.stop()
@@ -370,12 +376,13 @@ def test_hall_digital_input(motwin):
                 positions, velocities = turn_until_input_low(c, 0, 500, budget_ms=10000)
                 check(sim_ms(c) >= PRESS_INPUT_0_MS, "the first phase ended when input 0 was pressed")
                 check(any(abs(v - 500) <= 25 for v in velocities), f"500 rpm reached forwards: {velocities}")
-                check(positions and positions[-1] > 4096, f"turned forwards: AP 52 {positions[-3:]}")
+                # AP 56 = 24: AP 52 counts hall steps, 24 per revolution; at least one revolution.
+                check(positions and positions[-1] > 24, f"turned forwards: AP 52 {positions[-3:]}")
                 turned_to = c.gap(ACTUAL_POSITION)
                 positions, velocities = turn_until_input_low(c, 1, -500, budget_ms=10000)
                 check(sim_ms(c) >= PRESS_INPUT_1_MS, "the second phase ended when input 1 was pressed")
                 check(any(abs(v + 500) <= 25 for v in velocities), f"-500 rpm reached backwards: {velocities}")
-                check(positions[-1] < turned_to - 4096, f"turned backwards from {turned_to}: AP 52 {positions[-3:]}")
+                check(positions[-1] < turned_to - 24, f"turned backwards from {turned_to}: AP 52 {positions[-3:]}")
                 expect_reply(c.request(ROR, 0, 0, 0), ROR, STATUS_OK, what="ROR 0")
                 c.wait_sim_ms(1500)
                 velocity = c.gap(ACTUAL_VELOCITY)
