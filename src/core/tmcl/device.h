@@ -94,6 +94,13 @@ class TmclDevice {
   }
   virtual Status capture_coordinate(uint8_t /*number*/, uint8_t /*motor*/) { return Status::kInvalidCommand; }
 
+  // Command 142, the datalogger (docs/datalogger.md): type = sub-command, motor = its byte
+  // operand, value in (request) and out (reply; left alone, the reply echoes the request).
+  // Modules without it answer status 2 (invalid command).
+  virtual Status ram_debug(uint8_t /*type*/, uint8_t /*motor*/, int32_t& /*value*/) { return Status::kInvalidCommand; }
+  // Command 157, get info: type = entry id, value out. Modules without it answer status 2.
+  virtual Status get_info(uint8_t /*type*/, uint8_t /*motor*/, int32_t& /*value*/) { return Status::kInvalidCommand; }
+
  protected:
   ~TmclDevice() = default;
 };

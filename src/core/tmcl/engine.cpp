@@ -209,6 +209,15 @@ CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelI
     case command::kEnterAsciiMode:
     case command::kSoftwareReset:
       return module_command(in, channel);
+    case command::kRamDebug:
+    case command::kGetInfo: {
+      // Direct mode only: a stored program never gets here (the interpreter stops at any
+      // command >= 128 with "invalid instruction").
+      int32_t value = in.value;
+      const Status status = in.command == command::kRamDebug ? device_.ram_debug(in.type, in.motor_bank, value)
+                                                             : device_.get_info(in.type, in.motor_bank, value);
+      return status_only(status, status == Status::kOk ? value : in.value);
+    }
     default:
       return status_only(Status::kInvalidCommand, in.value);
   }

@@ -68,6 +68,8 @@ inline constexpr uint8_t kGetFirmwareVersion = 136;
 inline constexpr uint8_t kRestoreFactoryDefaults = 137;
 inline constexpr uint8_t kRequestPositionReachedEvent = 138;
 inline constexpr uint8_t kEnterAsciiMode = 139;
+inline constexpr uint8_t kRamDebug = 142;  // the datalogger (docs/datalogger.md)
+inline constexpr uint8_t kGetInfo = 157;   // firmware facts by id (docs/datalogger.md "Command 157")
 inline constexpr uint8_t kSoftwareReset = 255;
 }  // namespace command
 

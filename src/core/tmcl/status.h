@@ -12,6 +12,7 @@ enum class Status : uint8_t {
   kInvalidValue = 4,     // also: motor or bank number out of range
   kEepromLocked = 5,     // also: the EEPROM image could not be written
   kNotAvailable = 6,
+  kMaxExceeded = 9,      // the datalogger's (command 142) "maximum exceeded" (docs/datalogger.md)
   kOk = 100,
   kStoredInProgram = 101,
   kPositionReachedEvent = 128,  // second, delayed reply of command 138
@@ -27,6 +28,7 @@ constexpr const char* status_name(uint8_t code) {
     case 4: return "invalid value";
     case 5: return "configuration EEPROM locked";
     case 6: return "command not available";
+    case 9: return "maximum exceeded";
     case 100: return "ok";
     case 101: return "command stored";
     case 128: return "position reached";

@@ -41,6 +41,7 @@
 #include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
+#include "core/tmcl/ramdebug.h"
 #include "core/tmcl/runtime.h"
 
 namespace motwin::tmcl {
@@ -183,6 +184,71 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
     set_tick_timer_ms(0);
   }
   bool skip_user_variable_restore() const { return globals_.skip_user_variable_restore != 0; }
+  // Command 157 (get info) from the module's identity, for a module that answers it
+  // (docs/datalogger.md "Command 157"): 0 module number, 1 version (major << 16 | minor),
+  // 2 capabilities (TMCL only: Motwin has no bootloader), 3 release type (0, public), 20 the
+  // bit width of AP numbers (8). The bootloader, register and git entries and unknown ids:
+  // status 3, as Trinamic's eval firmware answers an entry it lacks.
+  Status firmware_info(uint8_t entry, int32_t& value) const {
+    const FirmwareIdentity& id = static_cast<const Derived&>(*this).identity();
+    switch (entry) {
+      case 0: value = id.module_number; return Status::kOk;
+      case 1: value = static_cast<int32_t>((uint32_t{id.version_major} << 16) | id.version_minor); return Status::kOk;
+      case 2: value = kCapabilityTmcl; return Status::kOk;
+      case 3: value = 0; return Status::kOk;
+      case 20: value = 8; return Status::kOk;
+      default: return Status::kWrongType;
+    }
+  }
+
+  // The datalogger's channels over the module's parameter tables, for a module with a
+  // datalogger (RamDebugChannels): an axis parameter (select: axis << 24 | number) or a global
+  // parameter (bank << 24 | number; bank 0 or the user variables of bank 2) is found once, here;
+  // each sample then costs the row's getter, the read GAP/GGP do. A motor or bank out of range:
+  // status 4, an unknown or unreadable parameter: status 3, as GAP/GGP answer; a channel type
+  // Motwin does not sample (registers, analog inputs): status 9 (docs/datalogger.md "Errors").
+  Status resolve_parameter_channel(uint8_t type, uint32_t select, RamDebugProbe& probe) {
+    const auto index = static_cast<uint8_t>(select >> 24);
+    const auto number = static_cast<uint16_t>(select & 0xFFFF);
+    switch (type) {
+      case ram_debug::channel_type::kAxisParameter: {
+        if (index >= kMotorCount) return Status::kInvalidValue;
+        const auto* row = derived().axis_table().find(number);
+        if (!readable(row)) return Status::kWrongType;
+        probe = RamDebugProbe{row, kProbeAxisRow, index};
+        return Status::kOk;
+      }
+      case ram_debug::channel_type::kGlobalParameter: {
+        if (index == kUserVariableBank) {
+          if (number >= kUserVariableCount) return Status::kWrongType;
+          probe = RamDebugProbe{nullptr, kProbeUserVariable, static_cast<uint8_t>(number)};
+          return Status::kOk;
+        }
+        if (index != kGlobalBank) return Status::kInvalidValue;
+        const auto* row = Derived::global_parameters().find(number);
+        if (!readable(row)) return Status::kWrongType;
+        probe = RamDebugProbe{row, kProbeGlobalRow, index};
+        return Status::kOk;
+      }
+      case ram_debug::channel_type::kSystick:
+        probe = RamDebugProbe{nullptr, kProbeTickTimer, 0};
+        return Status::kOk;
+      default:
+        return Status::kMaxExceeded;
+    }
+  }
+  int32_t read_parameter_channel(const RamDebugProbe& probe) {
+    switch (probe.kind) {
+      case kProbeAxisRow:
+      case kProbeGlobalRow:
+        return static_cast<const params::ParameterRow<Derived>*>(probe.source)->binding.get(derived(), probe.index);
+      case kProbeUserVariable:
+        return this->user_variables()[probe.index];
+      default:
+        return static_cast<int32_t>(tick_timer_ms_);
+    }
+  }
+
   // The actual position as the host reads it, which MVP REL adds to; a module whose parameter
   // rows transform it (the TMCM-1636's motor direction, AP 13 of firmware 1.13) hides this.
   int32_t host_actual_position() const { return axis_.actual_position(); }
@@ -194,6 +260,17 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   // The engine and the program memory refer to this object.
   TmclModule(const TmclModule&) = delete;
   TmclModule& operator=(const TmclModule&) = delete;
+
+  // Command 157 entry 2: bit 1, TMCL (bit 0 bootloader, 2 CANopen, 3 EtherCAT, 4 IO-Link).
+  static constexpr int32_t kCapabilityTmcl = 0x02;
+  // RamDebugProbe::kind of the channels resolve_parameter_channel() makes.
+  static constexpr uint8_t kProbeAxisRow = 1;
+  static constexpr uint8_t kProbeGlobalRow = 2;
+  static constexpr uint8_t kProbeUserVariable = 3;
+  static constexpr uint8_t kProbeTickTimer = 4;
+  static bool readable(const params::ParameterRow<Derived>* row) {
+    return row != nullptr && params::has(row->info.access, params::Access::kRead) && row->binding.get != nullptr;
+  }
 
   // MVP to an absolute position: a write of the target position parameter.
   Status move_to(uint8_t motor, int32_t position) {

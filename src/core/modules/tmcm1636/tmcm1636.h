@@ -21,6 +21,7 @@
 #include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
+#include "core/tmcl/ramdebug.h"
 #include "core/tmcl/tmcl_module.h"
 
 namespace motwin::modules::tmcm1636 {
@@ -49,6 +50,18 @@ enum class Firmware : uint8_t { kV109, kV113 };
 
 inline constexpr tmcl::FirmwareIdentity kIdentityV113{1636, 1, 13, "1636V113"};
 
+// The datalogger (command 142, docs/datalogger.md). The TMCM-1636's own figures are not public;
+// these are what the sister module TMCM-1617 reports in PyTrinamic's hardware test: a 2000 Hz
+// base rate, 8192 words of buffer, 4 channels. The base rate divides the 20 kHz control tick.
+inline constexpr uint32_t kRamDebugBaseRateHz = 2000;
+inline constexpr size_t kRamDebugBufferWords = 8192;
+inline constexpr uint32_t kRamDebugChannels = 4;
+inline constexpr uint32_t kControlTicksPerRamDebugTick = 1'000'000 / kControlTickUs / kRamDebugBaseRateHz;
+static_assert(kControlTicksPerRamDebugTick * kRamDebugBaseRateHz * kControlTickUs == 1'000'000,
+              "the datalogger's base rate divides the control tick rate");
+inline constexpr tmcl::RamDebugConfig kRamDebugConfig{kRamDebugChannels, kRamDebugBaseRateHz,
+                                                      kControlTicksPerRamDebugTick};
+
 inline constexpr tmcl::ModuleFacts kFacts{
     .name = "tmcm-1636",
     .identity = {1636, 1, 9, "1636V109"},
@@ -62,8 +75,10 @@ inline constexpr tmcl::ModuleFacts kFacts{
 
 // Runtime, tick timer, program memory, engine, I/O banks and the common motion commands come
 // from tmcl::TmclModule, the parameter commands, storage and power-up from tmcl::ModuleStorage;
-// the module adds its tables and the tick of its axis.
-class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts> {
+// the module adds its tables, the tick of its axis and the datalogger (commands 142 and 157, in
+// both firmware generations: docs/datalogger.md).
+class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts>,
+                       public tmcl::RamDebugChannels {
  public:
   Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io, Firmware firmware = Firmware::kV109)
       : TmclModule(nvm, io), firmware_(firmware), axis_table_(&axis_parameters(firmware)) {
@@ -92,15 +107,38 @@ class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalCon
     return position;
   }
 
-  // tmcl::TmclModule hook: one 50 µs control tick of the axis.
-  void tick_axis() { axis().tick(io(), static_cast<double>(kControlTickUs) * 1e-6); }
+  // tmcl::TmclModule hook: one 50 µs control tick of the axis, then the datalogger samples
+  // what this tick computed.
+  void tick_axis() {
+    axis().tick(io(), static_cast<double>(kControlTickUs) * 1e-6);
+    ram_debug_.control_tick();
+  }
 
-  // tmcl::ModuleStorage hook.
+  // tmcl::ModuleStorage hooks.
+  void clear_ram_state() {
+    TmclModule::clear_ram_state();
+    ram_debug_.init();
+  }
   void after_axis_restore() { axis().finish_restore(); }  // later writes are host commands
+
+  // TmclDevice: commands 142 and 157.
+  tmcl::Status ram_debug(uint8_t type, uint8_t motor, int32_t& value) override {
+    return ram_debug_.execute(type, motor, value);
+  }
+  tmcl::Status get_info(uint8_t type, uint8_t /*motor*/, int32_t& value) override { return firmware_info(type, value); }
+  const tmcl::RamDebug& datalogger() const { return ram_debug_; }
+
+  // tmcl::RamDebugChannels: axis and global parameters through the tables.
+  tmcl::Status resolve_ram_debug_channel(uint8_t type, uint32_t select, tmcl::RamDebugProbe& probe) override {
+    return resolve_parameter_channel(type, select, probe);
+  }
+  int32_t read_ram_debug_channel(const tmcl::RamDebugProbe& probe) override { return read_parameter_channel(probe); }
 
  private:
   Firmware firmware_;
   const Table* axis_table_;
+  std::array<uint32_t, kRamDebugBufferWords> ram_debug_buffer_{};
+  tmcl::RamDebug ram_debug_{*this, kRamDebugConfig, ram_debug_buffer_};
 };
 
 }  // namespace motwin::modules::tmcm1636
