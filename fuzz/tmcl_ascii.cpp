@@ -49,7 +49,7 @@ bool is_reply_line(const tmcl::AsciiResponse& response, const tmcl::AsciiSetting
   size_t digits = 0;
   while (i < n && b[i] >= '0' && b[i] <= '9') status = status * 10 + (b[i++] - '0'), ++digits;
   if (digits == 0 || digits > 3 || i >= n || b[i++] != ' ') return false;
-  if (!(status == 100 || status == 101 || status == 128 || (status >= 1 && status <= 6))) return false;
+  if (!tmcl::is_status_code(status)) return false;
   if (i < n && b[i] == '-') ++i;
   long long value = 0;
   digits = 0;

@@ -86,7 +86,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(reply.data[0] == (after.receive_id & 0xFF), "reply names receive ID %u, GP 71 is %u", reply.data[0],
                after.receive_id);
     const uint8_t status = reply.data[1];
-    FUZZ_CHECK(status == 100 || status == 101 || status == 128 || (status >= 1 && status <= 6),
+    FUZZ_CHECK(tmcl::is_status_code(status),
                "reply status %u to command %u", status, command);
     if (command != 134) FUZZ_CHECK(reply.data[2] == command, "reply echoes command %u, request %u", reply.data[2], command);
     if (!request) {

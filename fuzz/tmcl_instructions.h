@@ -16,10 +16,11 @@
 
 namespace motwin::fuzz {
 
-// The TMCL commands of the TMCM-1636 and TMCM-142 (manual table 4) and the control commands;
-// others by chance.
-inline constexpr std::array<uint8_t, 30> kTmclCommands{1,  2,  3,  4,  5,  6,  7,   8,   9,   10,  11,  12,  13,  14,  15,
-                                                       19, 20, 21, 22, 26, 27, 36,  128, 129, 130, 131, 132, 133, 138, 255};
+// The TMCL commands of the TMCM-1636 and TMCM-142 (manual table 4), the control commands and the
+// datalogger's 142 and 157 (docs/datalogger.md); others by chance.
+inline constexpr std::array<uint8_t, 32> kTmclCommands{1,  2,  3,  4,  5,   6,   7,   8,   9,   10,  11,
+                                                       12, 13, 14, 15, 19,  20,  21,  22,  26,  27,  36,
+                                                       128, 129, 130, 131, 132, 133, 138, 142, 157, 255};
 
 inline int32_t interesting_value(FuzzedDataProvider& in, const params::ParameterInfo* info) {
   switch (in.ConsumeIntegralInRange<int>(0, 5)) {
@@ -72,7 +73,7 @@ void execute_checked(Module& module, tmcl::TmclEngine& engine, const tmcl::Instr
   const bool readable_before = compare_write && read_parameter(module, instruction, before);
   const tmcl::CommandResult result = engine.execute(instruction, tmcl::Origin::kHost, 0);
   const uint8_t status = tmcl::to_byte(result.status);
-  FUZZ_CHECK(status == 100 || status == 101 || status == 128 || (status >= 1 && status <= 6),
+  FUZZ_CHECK(tmcl::is_status_code(status),
              "command %u type %u motor %u value %d: status %u", instruction.command, instruction.type,
              instruction.motor_bank, instruction.value, status);
   if (readable_before && (result.status == tmcl::Status::kWrongType || result.status == tmcl::Status::kInvalidValue)) {

@@ -86,7 +86,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(tmcl::checksum(response.bytes.data(), 8) == response.bytes[8], "reply to command %u: checksum",
                instruction.command);
     const uint8_t status = response.bytes[2];
-    FUZZ_CHECK(status == 100 || status == 101 || status == 128 || (status >= 1 && status <= 6),
+    FUZZ_CHECK(tmcl::is_status_code(status),
                "reply to command %u: status %u is no TMCL status", instruction.command, status);
     if (instruction.command != 134) {
       FUZZ_CHECK(response.bytes[3] == instruction.command, "reply echoes command %u instead of %u", response.bytes[3],

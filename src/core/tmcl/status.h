@@ -38,4 +38,7 @@ constexpr const char* status_name(uint8_t code) {
 
 constexpr bool is_success(uint8_t code) { return code == 100 || code == 101 || code == 128; }
 
+// A code of the enum above: what a reply may carry.
+constexpr bool is_status_code(uint8_t code) { return is_success(code) || (code >= 1 && code <= 6) || code == 9; }
+
 }  // namespace motwin::tmcl

@@ -126,7 +126,6 @@ class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalCon
     return ram_debug_.execute(type, motor, value);
   }
   tmcl::Status get_info(uint8_t type, uint8_t /*motor*/, int32_t& value) override { return firmware_info(type, value); }
-  const tmcl::RamDebug& datalogger() const { return ram_debug_; }
 
   // tmcl::RamDebugChannels: axis and global parameters through the tables.
   tmcl::Status resolve_ram_debug_channel(uint8_t type, uint32_t select, tmcl::RamDebugProbe& probe) override {
