@@ -5,15 +5,18 @@ datalogger_minimal.py and datalogger_demo.py) replayed frame by frame over TCP a
 DataLogger sends for them (docs/datalogger.md "What a host sends"), written from what the scripts
 do. The demo runs while the motor turns, so that its two channels can be checked against each
 other: the velocity near the commanded one, the position advancing by velocity x sample period.
+The same command over the pseudo-terminal and over TMCL on CAN, and command 157.
 """
 
 import os
 import struct
 import sys
+import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+from can_bus_harness import BusServer, TmclCan, open_bus  # noqa: E402
 from motwin_harness import (  # noqa: E402
     MST, ROR, STATUS_OK, Server, TempDir, check, check_equal, expect_reply, run_tests,
 )
@@ -124,6 +127,48 @@ def test_datalogger_demo_while_turning(motwin):
             server.stop()
 
 
+def test_datalogger_over_a_pseudo_terminal(motwin):
+    """The minimal example's frames over the pty link (what `serial_tmcl` uses)."""
+    with TempDir() as tmp:
+        link = os.path.join(tmp, "tmcm1636")
+        with Server113(motwin, os.path.join(tmp, "state"), tcp=False, pty_link=link,
+                       extra_args=REFERENCE_SETUP) as server:
+            with server.serial() as c:
+                words = capture(c, 10, 0, [ADC_PHASE_A])
+                for word in words:
+                    check(abs(word - 32767) < 1000, f"ADC phase A {word} at rest near mid-scale")
+            server.stop()
+
+
+def test_datalogger_over_can(motwin):
+    """A capture of AP 52 and GP 132 (the tick timer) over TMCL on CAN, on firmware 1.09 (the
+    default): 20 rows at 100 Hz (prescaler 19) span 190 ms of the module's clock."""
+    with TempDir() as tmp:
+        server = BusServer(motwin, os.path.join(tmp, "state"), ["--module", "tmcm-1636", "--can", "socketcand:127.0.0.1:0"])
+        with server:
+            bus = open_bus(server.port())
+            try:
+                tmcl = TmclCan(bus)
+                check_equal(tmcl.ok(RAMDEBUG, INFO, 0, 2), 2000, "info 2 over CAN")
+                tmcl.ok(RAMDEBUG, INIT)
+                tmcl.ok(RAMDEBUG, SAMPLE_COUNT, 0, 40)
+                tmcl.ok(RAMDEBUG, PRESCALER, 0, 19)
+                tmcl.ok(RAMDEBUG, CHANNEL, AXIS_PARAMETER, ACTUAL_POSITION)
+                tmcl.ok(RAMDEBUG, CHANNEL, 8, 132)  # GP 132, bank 0
+                tmcl.ok(RAMDEBUG, ENABLE_TRIGGER, 0, 0)
+                deadline = time.monotonic() + 60.0
+                while tmcl.ok(RAMDEBUG, STATE) != COMPLETE:
+                    check(time.monotonic() < deadline, "the capture completes within 60 s")
+                words = [tmcl.ok(RAMDEBUG, SAMPLE, 0, i) for i in range(40)]
+                ticks_ms = words[1::2]
+                check_equal(ticks_ms[-1] - ticks_ms[0], 190, "tick timer across 20 rows at 100 Hz (ms)")
+                check(all(p == words[0] for p in words[0::2]), f"the idle motor's position stays: {words[0::2]}")
+                check_equal(tmcl.request(RAMDEBUG, SAMPLE, 0, 40)[1], STATUS_MAX_EXCEEDED, "index 40 of 40")
+            finally:
+                bus.shutdown()
+            server.stop()
+
+
 def test_get_info_157(motwin):
     """Command 157 as TmclInterface.get_info() sends it: module id, version, capabilities,
     release type; an entry the module lacks answers status 3."""
@@ -139,4 +184,5 @@ def test_get_info_157(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_datalogger_minimal, test_datalogger_demo_while_turning, test_get_info_157])
+    run_tests([test_datalogger_minimal, test_datalogger_demo_while_turning, test_datalogger_over_a_pseudo_terminal,
+               test_datalogger_over_can, test_get_info_157])
