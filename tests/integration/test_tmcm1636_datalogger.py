@@ -94,7 +94,7 @@ def test_datalogger_minimal(motwin):
 def test_datalogger_demo_while_turning(motwin):
     """datalogger_demo.py: AP 42 and AP 52, 1024 samples each at 1000 Hz (down-sampling 2), here
     while the motor turns at 1000 rpm in ABN encoder velocity mode (the encoder example's
-    settings, 4096 counts per revolution)."""
+    settings, a 4096-count encoder). Firmware 1.13 counts AP 52 in AP 56 units per revolution."""
     with TempDir() as tmp:
         with Server113(motwin, os.path.join(tmp, "state"), extra_args=REFERENCE_SETUP) as server:
             with server.tcp() as c:
@@ -114,15 +114,17 @@ def test_datalogger_demo_while_turning(motwin):
                 position = [signed(w) for w in words[1::2]]
                 for v in velocity:
                     check(abs(v - 1000) <= 30, f"velocity sample {v} rpm near 1000")
-                # 1 ms per sample: velocity / 60 * 4096 counts.
+                # 1 ms per sample: velocity / 60 revolutions of AP 56 units.
+                per_revolution = c.gap(56)
                 steps = [b - a for a, b in zip(position, position[1:])]
                 mean_step = sum(steps) / len(steps)
-                expected = 1000 / 60 * 4096 * 0.001
+                expected = 1000 / 60 * per_revolution * 0.001
                 check(abs(mean_step - expected) < 0.02 * expected,
-                      f"position advances {mean_step:.2f} counts per sample, velocity x period {expected:.2f}")
+                      f"position advances {mean_step:.2f} units per sample, velocity x period {expected:.2f}")
                 for i, step in enumerate(steps):
-                    step_expected = (velocity[i] + velocity[i + 1]) / 2 / 60 * 4096 * 0.001
-                    check(abs(step - step_expected) <= 6, f"position step {i}: {step}, velocity says {step_expected:.1f}")
+                    step_expected = (velocity[i] + velocity[i + 1]) / 2 / 60 * per_revolution * 0.001
+                    check(abs(step - step_expected) <= 6 / 4096 * per_revolution,  # 6 encoder counts
+                          f"position step {i}: {step}, velocity says {step_expected:.1f}")
                 expect_reply(c.request(MST), MST, STATUS_OK, what="MST")
             server.stop()
 
