@@ -41,7 +41,11 @@ def test_inputs_outputs_and_switches(motwin):
             check_equal(bus.abort_code(bus.download, NODE, 0x2711, 0, 0x10, 2), ABORT_INVALID_VALUE, "2711 bit 4")
             bus.download(NODE, 0x2711, 0, 0x0101, 2)
             bus.download(NODE, 0x2703, 1, 1 << 16, 4)
-            check_equal(bus.upload_u(NODE, 0x2703, 1), 0, "2703 sub 1 without the mask")
+            check_equal(bus.upload_u(NODE, 0x2703, 1), 1 << 16, "2703 sub 1 reads back as written")
+            bus.wait_sim(NODE, 0.05)
+            check_equal(bus.upload_u(NODE, 0x2702, 0), 1 << 18, "2702: DIO0 not switched without the mask")
+            check_equal(bus.abort_code(bus.download, NODE, 0x2703, 1, 0x65766173, 4), ABORT_INVALID_VALUE,
+                        "2703 sub 1: bits that name no output")
             bus.download(NODE, 0x2703, 2, 0xF << 16, 4)
             bus.download(NODE, 0x2703, 1, 1 << 16, 4)
             check_equal(bus.upload_u(NODE, 0x2703, 1), 1 << 16, "2703 sub 1 through the mask")

@@ -436,12 +436,27 @@ TEST(Tmcm3216StepperObjects, SwitchEncoderAndBrakeObjectsOnlyInSwitchOnDisabled)
 
 TEST(Tmcm3216StepperObjects, IoObjects) {
   Rows rows;
-  // 2703: sub 1 switches only what the mask (sub 2) allows.
+  // 2703: sub 1 reads back as written; it switches only the outputs the mask (sub 2) allows.
   EXPECT_EQ(rows.write(0x2703, 1, 0x000F0000), canopen::SdoAbort::kNone);
-  EXPECT_EQ(rows.read(0x2703, 1), 0);
+  EXPECT_EQ(rows.read(0x2703, 1), 0x000F0000);
+  EXPECT_EQ(rows.module.io.output_levels(), 0u);
   EXPECT_EQ(rows.write(0x2703, 2, 0x00050000), canopen::SdoAbort::kNone);
   EXPECT_EQ(rows.write(0x2703, 1, 0x000F0000), canopen::SdoAbort::kNone);
-  EXPECT_EQ(rows.read(0x2703, 1), 0x00050000);
+  EXPECT_EQ(rows.read(0x2703, 1), 0x000F0000);
+  EXPECT_EQ(rows.module.io.output_levels(), 0x00050000u);
+  // Switching OUT0 off through a mask of OUT0 alone keeps OUT2 on.
+  EXPECT_EQ(rows.write(0x2703, 2, 0x00010000), canopen::SdoAbort::kNone);
+  EXPECT_EQ(rows.write(0x2703, 1, 0), canopen::SdoAbort::kNone);
+  EXPECT_EQ(rows.read(0x2703, 1), 0);
+  EXPECT_EQ(rows.module.io.output_levels(), 0x00040000u);
+  EXPECT_EQ(rows.write(0x2703, 2, 0x00050000), canopen::SdoAbort::kNone);
+  EXPECT_EQ(rows.write(0x2703, 1, 0x000F0000), canopen::SdoAbort::kNone);
+  // Bits that name no output (the module has OUT0..OUT3 at bits 16..19) are refused, the
+  // object unchanged: the canopen_sdo fuzz finding wrote "save" (0x65766173) here.
+  EXPECT_EQ(rows.write(0x2703, 1, 0x65766173), canopen::SdoAbort::kInvalidValue);
+  EXPECT_EQ(rows.write(0x2703, 1, 0x00100000), canopen::SdoAbort::kInvalidValue);
+  EXPECT_EQ(rows.write(0x2703, 1, 0x00000001), canopen::SdoAbort::kInvalidValue);
+  EXPECT_EQ(rows.read(0x2703, 1), 0x000F0000);
   // 2711: bits 0..3 and 8..11 only.
   EXPECT_EQ(rows.write(0x2711, 0, 0x0010), canopen::SdoAbort::kInvalidValue);
   EXPECT_EQ(rows.write(0x2711, 0, 0x0105), canopen::SdoAbort::kNone);

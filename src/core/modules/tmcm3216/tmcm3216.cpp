@@ -51,16 +51,36 @@ void Tmcm3216::power_up() {
 }
 
 void Tmcm3216::reset_node() {
-  // Application (motor) parameters, then the communication reset that ends with the boot-up.
+  // The processor restarts as at power-up: application, then communication; the boot-up
+  // follows after the restart time.
+  reset_application();
+  reset_communication(config_.boot_delay_us);
+}
+
+void Tmcm3216::reset_application() {
+  // The state behind every object of 2000h..9FFFh, value-initialised as at construction, so
+  // that nothing a master wrote survives unless it was stored (CiA-301 reset application): the
+  // stepper and profile objects of each axis, the drives' manufacturer objects, the I/O and the
+  // node settings (2704/2705). The live state (PDS, ramps, the stepper's counters) is reset below.
+  for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
+    steppers_[axis].objects = StepperObjects{};
+    drives_[axis].objects = cia402::ProfileObjects{};
+    drives_[axis].manufacturer = Tmcm3216DriveObjects{};
+  }
+  general_io_ = Tmcm3216GeneralIo{};
+  node_settings_ = NodeSettings{};
+  // Then what 1010 stored (or each object's default).
   StorageSelection application;
   application.axis_mask = kAllAxes;
+  application.node_settings = true;
   storage_.load(application);
   error_register_ = 0;
   reset_axes();
-  reset_communication();
 }
 
-void Tmcm3216::reset_communication() {
+void Tmcm3216::reset_communication() { reset_communication(config_.communication_boot_delay_us); }
+
+void Tmcm3216::reset_communication(uint32_t boot_delay_us) {
   nmt_.initialize();
   sdo_.reset();
   emergency_.reset();
@@ -69,16 +89,21 @@ void Tmcm3216::reset_communication() {
   reported_refused_writes_ = pdos_.refused_writes();
   reported_rpdo_writes_ = pdos_.rpdo_writes();
   // Node ID and bit rate first: the "$NODEID+" defaults of the communication objects use it.
+  // They come from the NVM (manual 4.2.62/4.2.63: write, store with 2706, reset); the objects
+  // 2704/2705 belong to the application and keep what a master wrote.
+  const NodeSettings written = node_settings_;
   StorageSelection node;
   node.node_settings = true;
   storage_.load(node);
+  const NodeSettings stored = node_settings_;
+  node_settings_ = written;
   const uint8_t switches = config_.node_id_switches;
-  node_id_ = switches >= 1 && switches <= 127 ? switches : node_settings_.node_id;
+  node_id_ = switches >= 1 && switches <= 127 ? switches : stored.node_id;
   // A node ID configured by LSS since power-up applies at every reset, even over the switches
   // (the master that configured it expects the node there).
   if (lss_.node_id_configured()) node_id_ = lss_.pending_node_id();
   // Likewise a bit rate activated by LSS stays until power-up.
-  bit_rate_kbit_ = lss_bit_rate_kbit_ != 0 ? lss_bit_rate_kbit_ : node_settings_.bit_rate_kbit;
+  bit_rate_kbit_ = lss_bit_rate_kbit_ != 0 ? lss_bit_rate_kbit_ : stored.bit_rate_kbit;
   dictionary_.set_node_id(configured() ? node_id_ : 0);
   nmt_.set_node_id(node_id_);
   sdo_.set_node_id(node_id_);
@@ -90,6 +115,14 @@ void Tmcm3216::reset_communication() {
   storage_.load(communication);  // 1005..1017 reach sync_, emergency_, heartbeat_consumer_, nmt_ by their bindings
   pdos_.reset();
   sync_.reset();
+  restarting_ = true;
+  restart_remaining_us_ = boot_delay_us;
+  if (boot_delay_us == 0) finish_restart();
+}
+
+void Tmcm3216::finish_restart() {
+  restarting_ = false;
+  restart_remaining_us_ = 0;
   // An LSS-unconfigured node (2705 = 255) stays silent: only LSS reaches it.
   if (configured()) nmt_.boot();
 }
@@ -109,7 +142,16 @@ void Tmcm3216::process(uint32_t elapsed_us) {
     const can::CanFrame frame = receive_queue_[receive_head_];
     receive_head_ = (receive_head_ + 1) % receive_queue_.size();
     --receive_count_;
+    if (restarting_) continue;  // a restarting node hears nothing (not even NMT or LSS)
     handle_frame(frame);
+  }
+  if (restarting_) {
+    if (elapsed_us < restart_remaining_us_) {
+      restart_remaining_us_ -= elapsed_us;
+      return;
+    }
+    finish_restart();
+    elapsed_us = 0;  // the services start from the boot-up
   }
   if (const uint16_t bit_rate = lss_.process(elapsed_us); bit_rate != 0) {
     lss_bit_rate_kbit_ = bit_rate;

@@ -74,6 +74,12 @@ struct Tmcm3216Config {
   // says switches do (4.2.63); 0 = no switches, 2705 decides.
   uint8_t node_id_switches = 0;
   uint32_t serial_number = 0;  // 1018 sub 4
+  // Restart times in simulated µs: from power-up or NMT reset node, and from NMT reset
+  // communication (also the one an LSS switch to waiting makes), to the boot-up message. The node
+  // hears and sends nothing meanwhile. 0 boots at once (the protocol tests); `motwin serve` uses
+  // Tmcm3216::kBootDelayUs and kCommunicationBootDelayUs (docs/canopen.md "Start-up timing").
+  uint32_t boot_delay_us = 0;
+  uint32_t communication_boot_delay_us = 0;
 };
 
 class Tmcm3216 final : private canopen::LssDevice {
@@ -99,6 +105,12 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr size_t kNvmRecordCapacity = 1024;
   static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
   static constexpr size_t kReceiveQueueLength = 32;
+  // The restart times `motwin serve` gives the module unless told otherwise (Tmcm3216Config).
+  // The manual gives none: a Motwin decision (docs/canopen.md "Start-up timing"). A reset node
+  // restarts the processor like a power-up (bootloader, three driver chips and the stored
+  // parameters set up again); a reset communication only sets up the CANopen stack again.
+  static constexpr uint32_t kBootDelayUs = 300'000;
+  static constexpr uint32_t kCommunicationBootDelayUs = 50'000;
 
   // Every object of the dictionary (tmcm3216_objects.cpp).
   static std::span<const Row> object_table();
@@ -112,7 +124,8 @@ class Tmcm3216 final : private canopen::LssDevice {
   Tmcm3216(const Tmcm3216&) = delete;
   Tmcm3216& operator=(const Tmcm3216&) = delete;
 
-  // Power-on: every object from the NVM (or its default), boot-up message, pre-operational.
+  // Power-on: every object from the NVM (or its default); after the boot delay the boot-up
+  // message and pre-operational.
   void power_up();
   // A frame from the bus (the CAN receive interrupt): queued for the next process() call.
   // false: the queue was full and the frame is lost.
@@ -126,6 +139,9 @@ class Tmcm3216 final : private canopen::LssDevice {
   uint8_t node_id() const { return node_id_; }            // active (2708)
   uint16_t bit_rate_kbit() const { return bit_rate_kbit_; }  // active (2707)
   bool configured() const { return node_id_ >= 1 && node_id_ <= 127; }
+  // Between a power-up or NMT reset and the boot-up (Tmcm3216Config's delays): frames received
+  // are dropped, nothing is sent.
+  bool restarting() const { return restarting_; }
   canopen::NmtState nmt_state() const { return nmt_.state(); }
   // 1001: communication bits, the FAULT bits of the axes, the active conditions of table 365.
   uint8_t error_register() const {
@@ -164,7 +180,12 @@ class Tmcm3216 final : private canopen::LssDevice {
   canopen::SdoAbort store_node_settings(uint32_t signature);
 
  private:
+  // NMT reset node (and power-up): the application objects (manufacturer and profile areas) to
+  // their power-on values, or the stored ones, then the communication reset.
   void reset_node();
+  // Every object of 2000h..9FFFh as power-on builds it: the objects' structs value-initialised,
+  // the stored values loaded on top, the axes' live state reset.
+  void reset_application();
   void reset_axes();
   void run_axes(uint32_t dt_us);
   void run_axis(uint8_t axis, uint32_t dt_us);
@@ -172,7 +193,13 @@ class Tmcm3216 final : private canopen::LssDevice {
   void sync_axes();
   // 1001 bits of the axes: generic + device profile while an axis is in FAULT (or reacting).
   uint8_t axis_error_register() const;
+  // NMT reset communication: the objects 1000h..1FFFh to their stored values or defaults, the
+  // node ID and bit rate as stored (2704/2705 themselves untouched), the services reset; the
+  // boot-up follows after `boot_delay_us`.
   void reset_communication();
+  void reset_communication(uint32_t boot_delay_us);
+  // The restart ends: boot-up (when configured), pre-operational.
+  void finish_restart();
   void handle_frame(const can::CanFrame& frame);
   void run_nmt(uint32_t elapsed_us);
   void run_heartbeat_consumer(uint32_t elapsed_us);
@@ -210,6 +237,8 @@ class Tmcm3216 final : private canopen::LssDevice {
   uint64_t reported_rpdo_writes_ = 0;
   bool parameter_error_ = false;  // EMCY 6320 sent, not yet cleared
   uint32_t service_elapsed_us_ = 0;
+  bool restarting_ = false;
+  uint32_t restart_remaining_us_ = 0;
 
   std::array<Tmcm3216Stepper, kAxisCount> steppers_{};
   std::array<Tmcm3216Drive, kAxisCount> drives_{};

@@ -16,13 +16,24 @@ class Tmcm3216GeneralIo {
   static constexpr uint8_t kFirstBit = 16;  // 2702 / 2703 / 60FD: DIO n at bit 16 + n
   static constexpr uint16_t kIoModeMask = 0x0F0F;  // 2711: bits 0..3 output mode, 8..11 push-pull
 
+  static constexpr uint32_t kOutputBits = ((1u << kDioCount) - 1) << kFirstBit;  // OUT0..OUT3
+
   // Objects (device-wide, not stored: the manual lists no store sub-index for them).
-  uint32_t outputs = 0;      // 2703 sub 1 as last written through the mask
-  uint32_t output_mask = 0;  // 2703 sub 2: bits 16..19 say which outputs sub 1 may switch
+  uint32_t outputs = 0;      // 2703 sub 1 as last written (what a read returns)
+  uint32_t output_mask = 0;  // 2703 sub 2: bits 16..19 say which outputs a write of sub 1 switches
   uint16_t io_mode = 0;      // 2711
 
-  // 2703 sub 1: only the bits the mask allows change.
-  void write_outputs(uint32_t value) { outputs = (outputs & ~output_mask) | (value & output_mask); }
+  // 2703 sub 1 holds the value written, as CiA-401's write-output object (6200h) with its filter
+  // mask (6208h) does: the object reads back as written, and of its bits only those the mask
+  // lets through switch their output; the others keep their level (docs/canopen.md "2703 sub 1").
+  // Bits that name no output of the module are refused by the dictionary (valid_outputs()).
+  void write_outputs(uint32_t value) {
+    outputs = value;
+    output_levels_ = (output_levels_ & ~output_mask) | (value & output_mask & kOutputBits);
+  }
+  static constexpr bool valid_outputs(uint32_t value) { return (value & ~kOutputBits) == 0; }
+  // The levels OUT0..OUT3 are switched to (bits 16..19).
+  uint32_t output_levels() const { return output_levels_; }
 
   // Before each tick: the pin levels and analog counts (board.io's input fields).
   void sample(const board::Tmcm3216Io& io) {
@@ -41,7 +52,7 @@ class Tmcm3216GeneralIo {
     for (uint8_t n = 0; n < kDioCount; ++n) {
       io.output_mode[n] = (io_mode & (1u << n)) != 0;
       io.push_pull[n] = (io_mode & (1u << (8 + n))) != 0;
-      io.output_levels[n] = (outputs & (1u << (kFirstBit + n))) != 0;
+      io.output_levels[n] = (output_levels_ & (1u << (kFirstBit + n))) != 0;
     }
     for (uint8_t m = 0; m < board::kTmcm3216AxisCount; ++m) {
       io.brake_control[m] = brake_control[m];
@@ -60,6 +71,7 @@ class Tmcm3216GeneralIo {
   uint16_t analog_input(uint8_t channel) const { return channel < board::Tmcm3216Io::kAnalogInputCount ? analog_[channel] : 0; }
 
  private:
+  uint32_t output_levels_ = 0;
   uint32_t inputs_ = 0;
   uint16_t analog_[board::Tmcm3216Io::kAnalogInputCount] = {};
 };

@@ -195,6 +195,10 @@ constexpr void add_io_rows(Table& t) {
       d.general_io().write_outputs(static_cast<uint32_t>(v));
       return SdoAbort::kNone;
     };
+    // Bits 16..19 only: the module has OUT0..OUT3 (table 173); other bits name no output.
+    b.check = [](Owner&, uint8_t, int64_t v) {
+      return Tmcm3216GeneralIo::valid_outputs(static_cast<uint32_t>(v)) ? SdoAbort::kNone : SdoAbort::kInvalidValue;
+    };
     t.add(r::mappable(r::row<Owner>(0x2703, 1, ObjectCode::kArray, "Device digital outputs", "Physical outputs",
                                     kUnsigned32, Access::kRw, 0, r::kU32Max, 0, b)));
   }

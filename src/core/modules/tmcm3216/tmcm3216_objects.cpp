@@ -5,6 +5,7 @@
 // stride exist once per motor (PDO parameters: + 0x40 per axis, manual 3.1.15-3.1.18).
 #include <array>
 
+#include "core/canopen/cob_id.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "core/modules/tmcm3216/tmcm3216_manufacturer_objects.h"
 #include "core/modules/tmcm3216/tmcm3216_profile_objects.h"
@@ -74,11 +75,7 @@ constexpr Row plus_node_id(Row r) {
 
 // --- Checks of SDO writes (CiA-301 rules the manual relies on) --------------------------------
 
-// CANopenNode's CO_IS_RESTRICTED_CAN_ID: identifiers a PDO or EMCY must not use.
-constexpr bool restricted_can_id(uint32_t id) {
-  return id <= 0x7F || (id >= 0x101 && id <= 0x180) || (id >= 0x581 && id <= 0x5FF) ||
-         (id >= 0x601 && id <= 0x67F) || (id >= 0x6E0 && id <= 0x6FF) || id >= 0x701;
-}
+using canopen::restricted_can_id;
 
 // A COB-ID of a PDO: 11-bit only, no restricted ID, and its ID does not change while it is valid
 // (set bit 31 first, as the manual's procedure and python-canopen do). Bit 30 (RTR) is accepted
@@ -272,7 +269,8 @@ constexpr Binding restore_binding() {
 
 // 1005: bit 30 makes the module the SYNC producer (with 1006), a Motwin extension: the manual's
 // module is a consumer only (1.1), and the factory value keeps it one. 29-bit identifiers are not
-// supported (table 12).
+// supported (table 12), restricted identifiers are refused, and the identifier is fixed while
+// bit 30 is set (docs/canopen.md "SDO abort codes").
 constexpr Binding sync_cob_id_binding() {
   Binding b;
   b.get = [](Tmcm3216& d, uint8_t) { return static_cast<int64_t>(d.communication().sync_cob_id); };
@@ -281,9 +279,20 @@ constexpr Binding sync_cob_id_binding() {
     d.sync().set_cob_id(static_cast<uint32_t>(v));
     return SdoAbort::kNone;
   };
-  b.check = [](Tmcm3216&, uint8_t, int64_t v) {
+  b.check = [](Tmcm3216& d, uint8_t, int64_t value) {
+    const uint32_t v = static_cast<uint32_t>(value);
+    const uint32_t current = d.communication().sync_cob_id;
     const uint32_t allowed = kCobIdMask | canopen::kSyncProducerBit;
-    return (static_cast<uint32_t>(v) & ~allowed) != 0 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+    if ((v & ~allowed) != 0) return SdoAbort::kInvalidValue;
+    // The restricted identifiers the PDO and EMCY COB-IDs refuse too (CiA-301 7.3.5).
+    if (restricted_can_id(v & kCobIdMask)) return SdoAbort::kInvalidValue;
+    // CiA-301 7.5.2.5: bits 29..0 do not change while the node produces SYNC (bit 30 set now);
+    // a master clears bit 30 first (same identifier), then writes the new one.
+    constexpr uint32_t kIdentifierBits = 0x3FFF'FFFF;
+    if ((current & canopen::kSyncProducerBit) != 0 && ((v ^ current) & kIdentifierBits) != 0) {
+      return SdoAbort::kInvalidValue;
+    }
+    return SdoAbort::kNone;
   };
   return b;
 }
