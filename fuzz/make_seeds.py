@@ -7,6 +7,7 @@ The seeds are committed; libFuzzer adds what it finds to a copy (scripts/fuzz.sh
 """
 
 import argparse
+import base64
 import os
 import random
 import re
@@ -293,6 +294,15 @@ def sdo_request(ccs_byte, index, sub, payload=()):
 SAVE, LOAD = 0x65766173, 0x64616F6C
 
 
+# 2026-11-26: 2703 sub 1 acknowledged "save" (0x65766173) and read 0 (issue 17).
+CANOPEN_SDO_FINDINGS = [
+    ("finding_2026_11_26_2703_sub1_reads_back",
+     "AQMBAABkYW9sAhARIwEDAGV2YXMBJwMjAQMAZXZhcwQQECMBAwDNYW9sARARIwEDAAAAAADKysrKysrKysrKysrKysrKysrKysrKygEQ"
+     "AAAAAAEAAgBzARAQIwAAIAEaACMBAwAAAAAAAhoAQAEDAAAAAYEBGAAjAQMAAAAAAgAaAC8BAwBgZAAgAhoAIwEDAGBBAPMAAAAtGgAB"
+     "AQMAAAAE0gEQECMBAwM="),
+]
+
+
 def canopen_sdo_seeds():
     # fuzz/canopen_sdo.cpp: per step int(0..9): 0 NMT (bool: one of 01 02 80 81 82 by int(0..4),
     # else a byte; bool: node 0 = all, else this node), 1 any frame (ID 0..7FF, remote when
@@ -411,6 +421,19 @@ def canopen_sdo_seeds():
          .sdo(*sdo_request(0x23, 0x607A, 0, le(100000))).sdo(*sdo_request(0x2B, 0x6040, 0, le(0x1F, 2)))
          .sdo(*sdo_request(0x40, 0x6041, 0)).sdo(*sdo_request(0x2F, 0x6860, 0, [3]))
          .sdo(*sdo_request(0x2F, 0x7060, 0, [6])).sdo(*sdo_request(0x23, 0x2705, 0, [5])))
+    # The conformance cases of issue 17 (tests/unit/core_tmcm3216_reset_test.cpp): 6060 and the
+    # I/O written, NMT reset node, read back; 1005 with restricted identifiers and a new one while
+    # producing.
+    seed("conformance_reset_node_and_1005", Steps().sdo(*sdo_request(0x2F, 0x6060, 0, [1]))
+         .sdo(*sdo_request(0x23, 0x2703, 2, le(0x000F0000))).sdo(*sdo_request(0x23, 0x2703, 1, le(0x00050000)))
+         .sdo(*sdo_request(0x2B, 0x2711, 0, le(0x0101, 2))).nmt(0x81).sdo(*sdo_request(0x40, 0x6060, 0))
+         .sdo(*sdo_request(0x40, 0x2703, 1)).sdo(*sdo_request(0x23, 0x1005, 0, le(0x000)))
+         .sdo(*sdo_request(0x23, 0x1005, 0, le(0x701))).sdo(*sdo_request(0x23, 0x1005, 0, le(0x40000080)))
+         .sdo(*sdo_request(0x23, 0x1005, 0, le(0x40000081))).sdo(*sdo_request(0x23, 0x1005, 0, le(0x80)))
+         .sdo(*sdo_request(0x23, 0x1005, 0, le(0x81))).nmt(0x82).sdo(*sdo_request(0x40, 0x1005, 0)))
+    # Inputs of findings (fuzz/README.md "Findings"), kept byte for byte: each replays its bug.
+    for name, text in CANOPEN_SDO_FINDINGS:
+        write("canopen_sdo", name, base64.b64decode(text))
 
 
 def canopen_pdo_seeds():

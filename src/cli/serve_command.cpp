@@ -72,6 +72,8 @@ struct ServeArguments {
   std::vector<std::string> nodes;
   std::string can_bitrate = "1M";
   double can_stats_s = 0;
+  int boot_delay_ms = -1;       // -1: the module's default
+  int comm_boot_delay_ms = -1;  // -1: the module's default
   bool module_given = false;
 };
 
@@ -217,6 +219,23 @@ Result<ModulePlan> check_module_arguments(const ServeArguments& arguments) {
       });
   if (!nodes) return Error{nodes.error()};
   plan.nodes = std::move(*nodes);
+  // --boot-delay-ms / --comm-boot-delay-ms: the module's, or every CANopen node's unless its own
+  // key says otherwise.
+  if (arguments.boot_delay_ms >= 0) plan.options.boot_delay_ms = static_cast<uint32_t>(arguments.boot_delay_ms);
+  if (arguments.comm_boot_delay_ms >= 0) {
+    plan.options.communication_boot_delay_ms = static_cast<uint32_t>(arguments.comm_boot_delay_ms);
+  }
+  const bool delays_given = plan.options.boot_delay_ms || plan.options.communication_boot_delay_ms;
+  if (plan.nodes.empty() && delays_given && plan.descriptor->canopen == nullptr) {
+    return Error{"--boot-delay-ms and --comm-boot-delay-ms are for CANopen modules (" +
+                 host::module_names([](const host::ModuleDescriptor& module) { return module.canopen != nullptr; }) +
+                 ")"};
+  }
+  for (host::NodeSpec& node : plan.nodes) {
+    if (host::find_module(node.module)->canopen == nullptr) continue;
+    if (!node.boot_delay_ms) node.boot_delay_ms = plan.options.boot_delay_ms;
+    if (!node.communication_boot_delay_ms) node.communication_boot_delay_ms = plan.options.communication_boot_delay_ms;
+  }
   return plan;
 }
 
@@ -650,7 +669,7 @@ void add_serve_command(CLI::App& app, int& exit_status) {
   serve->add_option("--node", arguments->nodes,
                     "Put several modules on one CAN bus in this process instead of --module: "
                     "MODULE[:KEY=VALUE,...] with keys name (state subdirectory, default MODULE-POSITION), node-id "
-                    "and serial (CANopen), motor, firmware (as --firmware), receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
+                    "and serial (CANopen), boot-delay-ms and comm-boot-delay-ms (CANopen: as --boot-delay-ms), motor, firmware (as --firmware), receive-id and send-id (TMCL: GP 71/70, stored). Repeatable; the nodes speak "
                     "CAN only (see the examples below)")
       ->type_name("MODULE[:KEY=VALUE,...]")
       ->expected(1)
@@ -702,6 +721,17 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "stored node ID (default 1) applies")
       ->type_name("N")
       ->check(CLI::Range(1, 127));
+  serve->add_option("--boot-delay-ms", arguments->boot_delay_ms,
+                    "CANopen: restart time from power-up or NMT reset node to the boot-up message, in simulated "
+                    "ms (default 300; the node answers nothing meanwhile). Applies to every CANopen --node "
+                    "without its own boot-delay-ms key")
+      ->type_name("MS")
+      ->check(CLI::Range(0, static_cast<int>(host::kMaxBootDelayMs)));
+  serve->add_option("--comm-boot-delay-ms", arguments->comm_boot_delay_ms,
+                    "CANopen: restart time from NMT reset communication to the boot-up message, in simulated ms "
+                    "(default 50)")
+      ->type_name("MS")
+      ->check(CLI::Range(0, static_cast<int>(host::kMaxBootDelayMs)));
   serve->add_option("--state-dir", arguments->state_dir,
                     "Directory of the EEPROM image file <module>.eeprom (default $XDG_DATA_HOME/motwin or "
                     "~/.local/share/motwin); \"none\" keeps the image in memory only")

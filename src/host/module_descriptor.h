@@ -44,6 +44,11 @@ struct ModuleOptions {
   // CANopen identity 1018 sub 4; 0: the module's default (1). Distinct serials tell two
   // unconfigured modules apart in an LSS fastscan.
   uint32_t serial_number = 0;
+  // CANopen restart times in ms (`--boot-delay-ms`, `--comm-boot-delay-ms`): from power-up or NMT
+  // reset node, and from NMT reset communication, to the boot-up; nullopt: the module's default
+  // (docs/canopen.md "Start-up timing").
+  std::optional<uint32_t> boot_delay_ms;
+  std::optional<uint32_t> communication_boot_delay_ms;
   LogSink log = log_to_stderr;
 };
 

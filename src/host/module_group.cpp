@@ -60,8 +60,15 @@ Result<void> apply_node_key(std::string_view item, NodeSpec& spec) {
       return Error{std::string(key) + " must be 0..255 (GP 70/71), got \"" + std::string(value) + "\""};
     }
     (key == "receive-id" ? spec.receive_id : spec.send_id) = static_cast<int32_t>(*number);
+  } else if (key == "boot-delay-ms" || key == "comm-boot-delay-ms") {
+    if (!number || *number < 0 || *number > kMaxBootDelayMs) {
+      return Error{std::string(key) + " must be 0.." + std::to_string(kMaxBootDelayMs) + " (ms), got \"" +
+                   std::string(value) + "\""};
+    }
+    (key == "boot-delay-ms" ? spec.boot_delay_ms : spec.communication_boot_delay_ms) = static_cast<uint32_t>(*number);
   } else {
-    return Error{"unknown key \"" + std::string(key) + "\" (name, node-id, serial, motor, firmware, receive-id, send-id)"};
+    return Error{"unknown key \"" + std::string(key) +
+                 "\" (name, node-id, serial, motor, firmware, receive-id, send-id, boot-delay-ms, comm-boot-delay-ms)"};
   }
   return {};
 }
@@ -70,12 +77,17 @@ Result<void> apply_node_key(std::string_view item, NodeSpec& spec) {
 Result<std::unique_ptr<VirtualModule>> make_member(const NodeSpec& spec,
                                                    const std::optional<std::filesystem::path>& state_dir,
                                                    const LogSink& log) {
+  if ((spec.boot_delay_ms || spec.communication_boot_delay_ms) && find_module(spec.module)->canopen == nullptr) {
+    return Error{"boot-delay-ms/comm-boot-delay-ms are for CANopen modules"};
+  }
   ModuleOptions options;
   if (state_dir) options.state_dir = *state_dir / spec.name;
   options.node_id = spec.node_id;
   options.serial_number = spec.serial_number;
   options.motor = spec.motor;
   options.firmware = spec.firmware;
+  options.boot_delay_ms = spec.boot_delay_ms;
+  options.communication_boot_delay_ms = spec.communication_boot_delay_ms;
   options.log = log;
   MakeModuleResult made = make_module(spec.module, options);
   if (!made) return made;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,7 +27,14 @@ struct NodeSpec {
   std::string firmware;      // firmware=NAME (ModuleDescriptor::firmwares; empty: the default)
   int32_t receive_id = -1;   // receive-id=N (TMCL modules: GP 71 at start-up)
   int32_t send_id = -1;      // send-id=N (GP 70)
+  // boot-delay-ms=N, comm-boot-delay-ms=N (CANopen modules: ModuleOptions); nullopt: serve's
+  // --boot-delay-ms / --comm-boot-delay-ms, or the module's default.
+  std::optional<uint32_t> boot_delay_ms;
+  std::optional<uint32_t> communication_boot_delay_ms;
 };
+
+// The longest restart time `boot-delay-ms` and `--boot-delay-ms` take (one minute).
+inline constexpr long kMaxBootDelayMs = 60'000;
 
 // "tmcm-3216:node-id=2,name=left". `position` (1-based) names an unnamed node. An unknown module
 // or key, or a value out of range, is an error.

@@ -15,7 +15,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from can_bus_harness import BusServer, check, check_equal  # noqa: E402
-from canopen_harness import CanopenClient  # noqa: E402
+from canopen_harness import CanopenClient, TestFailure  # noqa: E402
 from motwin_harness import TempDir, run_tests  # noqa: E402
 
 VENDOR, PRODUCT, REVISION = 0x286, 3216, 0x00010004
@@ -113,8 +113,15 @@ def test_fastscan_finds_unconfigured_modules(motwin):
             client = CanopenClient(server.port())
             try:
                 client.nmt(0x81, 0)
-                # Reset: an unconfigured slave answers a fastscan reset (the master's first question).
-                client.lss([0x51, 0, 0, 0, 0, 0x80, 0, 0])
+                # Reset: an unconfigured slave answers a fastscan reset (the master's first question)
+                # once its restart time has passed (docs/canopen.md "Start-up timing"); it sends no
+                # boot-up, so the master asks again until one answers (bounded).
+                for attempt in range(100):
+                    try:
+                        client.lss([0x51, 0, 0, 0, 0, 0x80, 0, 0], timeout=0.1)
+                        break
+                    except TestFailure:
+                        check(attempt < 99, "no unconfigured slave answered the fastscan reset")
                 check_equal(lss_ok(motwin, server, "fastscan", "--step-timeout", FASTSCAN_STEP_TIMEOUT,
                                    "--node-id", "20", "--store"),
                             f"vendor 0x{VENDOR:08X} product 0x{PRODUCT:08X} revision 0x{REVISION:08X} serial 0x00000003",

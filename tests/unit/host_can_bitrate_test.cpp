@@ -208,6 +208,10 @@ class Tmcm3216OnBus : public ::testing::Test {
   std::unique_ptr<VirtualModule> module;
 };
 
+// The restart times `motwin serve` gives the module, and a little more (docs/canopen.md).
+constexpr uint32_t kRestartMs = modules::tmcm3216::Tmcm3216::kBootDelayUs / 1000 + 10;
+constexpr uint32_t kCommunicationRestartMs = modules::tmcm3216::Tmcm3216::kCommunicationBootDelayUs / 1000 + 10;
+
 TEST_F(Tmcm3216OnBus, lss_activated_bit_rate_cuts_the_node_off_until_the_bus_follows) {
   ASSERT_TRUE(answers());
   send(0x7E5, {0x04, 0x01, 0, 0, 0, 0, 0, 0});  // switch state global: configuration
@@ -224,7 +228,7 @@ TEST_F(Tmcm3216OnBus, lss_activated_bit_rate_cuts_the_node_off_until_the_bus_fol
   EXPECT_GE(node_stats().frames_missed, 1u);
   // NMT reset communication: an LSS-activated rate stays until power-up.
   send(0x000, {0x82, 5});
-  run_ms(10);
+  run_ms(kCommunicationRestartMs);
   EXPECT_FALSE(answers());
   // The master's adapter follows (CiA-305: every node and the master switch): back on the bus.
   bus.set_bit_rate(500'000);
@@ -240,7 +244,7 @@ TEST_F(Tmcm3216OnBus, stored_2704_applies_at_the_next_reset) {
   EXPECT_TRUE(answers()) << "2704 applies at the next reset only";
   master.frames.clear();
   send(0x000, {0x81, 5});  // reset node
-  run_ms(10);
+  run_ms(kRestartMs);
   EXPECT_TRUE(master.frames.empty()) << "no boot-up at 1 Mbit/s";
   EXPECT_TRUE(node_stats().off_speed);
   EXPECT_GE(node_stats().frames_not_sent, 1u) << "the boot-up was counted";
@@ -251,7 +255,7 @@ TEST_F(Tmcm3216OnBus, stored_2704_applies_at_the_next_reset) {
   ASSERT_TRUE(ok(sdo({0x2B, 0x04, 0x27, 0x00, 0xE8, 0x03, 0, 0})));
   ASSERT_TRUE(ok(sdo({0x23, 0x06, 0x27, 0x01, 0x73, 0x61, 0x76, 0x65})));
   send(0x000, {0x81, 5});
-  run_ms(10);
+  run_ms(kRestartMs);
   EXPECT_FALSE(answers());
   bus.set_bit_rate(1'000'000);
   EXPECT_TRUE(answers());

@@ -21,14 +21,21 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   modules::tmcm3216::Tmcm3216Config config;
   config.node_id_switches = options.node_id;
   config.serial_number = options.serial_number != 0 ? options.serial_number : 1;
+  config.boot_delay_us = options.boot_delay_ms ? *options.boot_delay_ms * 1000u : Device::kBootDelayUs;
+  config.communication_boot_delay_us = options.communication_boot_delay_ms
+                                           ? *options.communication_boot_delay_ms * 1000u
+                                           : Device::kCommunicationBootDelayUs;
   module->board_ = std::make_unique<sim::Tmcm3216SimBoard>(*motors);
   for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
   module->board_->before_tick();
   board::CanController& controller = *module;  // private base: reachable here only
   module->device_ = std::make_unique<Device>(module->eeprom_.nvm(), controller, module->board_->board(), config);
-  // Powered up before any bus is connected: this boot-up reaches nobody, as on a real bus that a
-  // master joins later. Masters send an NMT reset to see one (docs/canopen.md).
+  // Switched on before any bus is connected and before `ready`: its restart time passes (the
+  // services only: nothing moves before the boot-up) and its boot-up reaches nobody, as on a real
+  // bus that a master joins later. Masters send an NMT reset to see one (docs/canopen.md
+  // "Start-up timing").
   module->device_->power_up();
+  module->device_->process(config.boot_delay_us);
   return MakeModuleResult(std::move(module));
 }
 
