@@ -117,6 +117,7 @@ void Tmcm3216::reset_communication(uint32_t boot_delay_us) {
   sync_.reset();
   restarting_ = true;
   restart_remaining_us_ = boot_delay_us;
+  service_elapsed_us_ = 0;  // the restart time counts from the reset, not from the last service tick
   if (boot_delay_us == 0) finish_restart();
 }
 
@@ -138,6 +139,7 @@ bool Tmcm3216::receive(const can::CanFrame& frame) {
 }
 
 void Tmcm3216::process(uint32_t elapsed_us) {
+  const bool was_restarting = restarting_;
   while (receive_count_ > 0) {
     const can::CanFrame frame = receive_queue_[receive_head_];
     receive_head_ = (receive_head_ + 1) % receive_queue_.size();
@@ -145,6 +147,9 @@ void Tmcm3216::process(uint32_t elapsed_us) {
     if (restarting_) continue;  // a restarting node hears nothing (not even NMT or LSS)
     handle_frame(frame);
   }
+  // A restart that a frame of this call began counts from now: the frames came at the end of
+  // the interval `elapsed_us` stands for.
+  if (restarting_ && !was_restarting) elapsed_us = 0;
   if (restarting_) {
     if (elapsed_us < restart_remaining_us_) {
       restart_remaining_us_ -= elapsed_us;
