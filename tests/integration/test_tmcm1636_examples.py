@@ -171,6 +171,21 @@ HALL_AS_WIRED = ((91, 0), (90, 1), (93, 0), (92, 1))  # direction, polarity 1, o
 FASTER = ["--speed", "4"]
 
 
+def hall_example_setup(c):
+    """What hall_position_mode.py and hall_digital_input.py send first: the drive, the halls as
+    wired, the ramp, the position scaler (hall states per revolution) and the examples' gains,
+    with the reads their prints make."""
+    set_all(c, ((14, 3), (10, 4), (11, 2000), (15, 2), (53, 5), (54, 500)))
+    print_settings(c, DRIVE_SETTINGS_READS)
+    set_all(c, HALL_AS_WIRED)
+    print_settings(c, DIGITAL_HALL_READS)
+    set_all(c, ((43, 2000), (44, 1000), (45, 1)))
+    print_settings(c, LINEAR_RAMP_READS)
+    c.sap(56, 6 * c.gap(10))
+    set_all(c, EXAMPLE_GAINS)
+    print_settings(c, PID_READS)
+
+
 def test_hall_position_mode(motwin):
     """hall_position_mode.py: hall commutation, the examples' gains, position scaler 6 x pole
     pairs, AP 52 = 0, MVP 0, then MVP 4000 and back to 0, each waiting for AP 55. A new MVP
@@ -178,15 +193,7 @@ def test_hall_position_mode(motwin):
     with TempDir() as tmp:
         with LaterFirmwareServer(motwin, os.path.join(tmp, "state"), extra_args=REFERENCE_MOTOR + FASTER) as server:
             with server.tcp() as c:
-                set_all(c, ((14, 3), (10, 4), (11, 2000), (15, 2), (53, 5), (54, 500)))
-                print_settings(c, DRIVE_SETTINGS_READS)
-                set_all(c, HALL_AS_WIRED)
-                print_settings(c, DIGITAL_HALL_READS)
-                set_all(c, ((43, 2000), (44, 1000), (45, 1)))
-                print_settings(c, LINEAR_RAMP_READS)
-                c.sap(56, 6 * c.gap(10))  # hall states per revolution
-                set_all(c, EXAMPLE_GAINS)
-                print_settings(c, PID_READS)
+                hall_example_setup(c)
                 c.sap(ACTUAL_POSITION, 0)
                 move_to(c, 0)
                 check_equal(c.gap(POSITION_REACHED), 1, "AP 55 at rest on the target of MVP 0")
@@ -359,15 +366,7 @@ def test_hall_digital_input(motwin):
         inputs = ["--set", "GPI0=1", "--set", "GPI1=1", "--scenario", scenario]
         with LaterFirmwareServer(motwin, os.path.join(tmp, "state"), extra_args=REFERENCE_MOTOR + inputs) as server:
             with server.tcp() as c:
-                set_all(c, ((14, 3), (10, 4), (11, 2000), (15, 2), (53, 5), (54, 500)))
-                print_settings(c, DRIVE_SETTINGS_READS)
-                set_all(c, HALL_AS_WIRED)
-                print_settings(c, DIGITAL_HALL_READS)
-                set_all(c, ((43, 2000), (44, 1000), (45, 1)))
-                print_settings(c, LINEAR_RAMP_READS)
-                c.sap(56, 6 * c.gap(10))
-                set_all(c, EXAMPLE_GAINS)
-                print_settings(c, PID_READS)
+                hall_example_setup(c)
                 c.wait_sim_ms(1000)
                 c.sap(ACTUAL_POSITION, 0)
                 started_ms = sim_ms(c)

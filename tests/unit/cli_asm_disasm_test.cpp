@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "support/motwin_cli.h"
 #include "tools/child_process.h"
 #include "tools/loopback_frame_server.h"
 #include "tools/serve_process.h"
@@ -17,16 +18,10 @@
 namespace motwin::tools {
 namespace {
 
-using namespace std::chrono_literals;
+using motwin::testing::run_motwin;
+
 
 const std::string kProgramsDir = MOTWIN_TEST_PROGRAMS_DIR;
-
-CompletedProcess run_motwin(std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), MOTWIN_BINARY);
-  Result<CompletedProcess> completed = ChildProcess::run(arguments, 20s);
-  if (!completed) ADD_FAILURE() << completed.error();
-  return completed ? completed.value() : CompletedProcess{-1, {}};
-}
 
 bool contains(const std::string& text, std::string_view part) { return text.find(part) != std::string::npos; }
 

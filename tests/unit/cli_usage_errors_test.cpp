@@ -7,20 +7,15 @@
 #include <vector>
 
 #include "cli/usage_hints.h"
+#include "support/motwin_cli.h"
 #include "tools/child_process.h"
 #include "tools/serve_process.h"
 
 namespace motwin::tools {
 namespace {
 
-using namespace std::chrono_literals;
+using motwin::testing::run_motwin;
 
-CompletedProcess run_motwin(std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), MOTWIN_BINARY);
-  Result<CompletedProcess> completed = ChildProcess::run(arguments, 20s);
-  if (!completed) ADD_FAILURE() << completed.error();
-  return completed ? completed.value() : CompletedProcess{-1, {}};
-}
 
 TEST(UsageHints, the_closest_name_is_a_unique_extension_or_a_near_spelling) {
   const std::vector<std::string> commands{"serve", "status", "start", "stop", "step", "sdo"};

@@ -19,6 +19,7 @@
 #include "host/module_descriptor.h"
 #include "host/module_listing.h"
 #include "host/module_registry.h"
+#include "support/motwin_cli.h"
 #include "tools/child_process.h"
 #include "tools/eds_writer.h"
 #include "tools/parameter_listing.h"
@@ -27,14 +28,9 @@
 namespace motwin::host {
 namespace {
 
-using namespace std::chrono_literals;
+using motwin::testing::run_motwin;
 
-tools::CompletedProcess run_motwin(std::vector<std::string> arguments) {
-  arguments.insert(arguments.begin(), MOTWIN_BINARY);
-  Result<tools::CompletedProcess> completed = tools::ChildProcess::run(arguments, 30s);
-  if (!completed) ADD_FAILURE() << completed.error();
-  return completed ? completed.value() : tools::CompletedProcess{-1, {}};
-}
+using namespace std::chrono_literals;
 
 bool contains(const std::string& text, std::string_view part) { return text.find(part) != std::string::npos; }
 
