@@ -6,6 +6,8 @@
 // it); the rest is the file. Invariants:
 // - bytes that validate are loaded as they are: the file is not rewritten, the module's image is
 //   the payload, and encoding that payload again gives the same bytes;
+// - a valid image of an older layout the module migrates (TMCM-142 layout 1) is migrated: one log
+//   line, the module's image is what its migrate_image() makes of the payload, the file valid;
 // - anything else is reported by exactly one log line containing "damaged", the bytes are kept
 //   unchanged as <image>.damaged, and the new file is a valid factory image;
 // - never a crash, never an exception.
@@ -62,6 +64,18 @@ void load(const std::vector<uint8_t>& bytes) {
   }
 
   const std::string problem = host::EepromFile::validate(identity, bytes).error();
+  // A valid image of an older layout the module migrates (the TMCM-142's layout 1): what it must
+  // become, or empty.
+  std::vector<uint8_t> migrated_payload;
+  if (!problem.empty() && identity.migrate_layout && bytes.size() >= host::EepromFile::kHeaderSize) {
+    host::EepromImageIdentity stored = identity;
+    stored.layout_version = static_cast<uint32_t>(bytes[48]) | (static_cast<uint32_t>(bytes[49]) << 8) |
+                            (static_cast<uint32_t>(bytes[50]) << 16) | (static_cast<uint32_t>(bytes[51]) << 24);
+    if (stored.layout_version != identity.layout_version && host::EepromFile::validate(stored, bytes).ok()) {
+      std::vector<uint8_t> payload(bytes.begin() + host::EepromFile::kHeaderSize, bytes.end());
+      if (identity.migrate_layout(stored.layout_version, payload.data(), payload.size())) migrated_payload = payload;
+    }
+  }
   std::vector<std::string> log;
   auto opened = host::EepromFile::open(
       state_dir, identity, [](uint8_t* image, size_t size) { Device::format_factory_image(image, size); },
@@ -77,6 +91,14 @@ void load(const std::vector<uint8_t>& bytes) {
     FUZZ_CHECK(std::equal(file.data(), file.data() + file.size(), bytes.begin() + host::EepromFile::kHeaderSize,
                           bytes.end()),
                "the loaded payload differs from the file's");
+  } else if (!migrated_payload.empty()) {
+    FUZZ_CHECK(file.load_outcome() == host::EepromLoadOutcome::kMigrated, "an older layout was not migrated");
+    FUZZ_CHECK(log.size() == 1 && log[0].find("migrated") != std::string::npos, "%zu log lines for a migration",
+               log.size());
+    FUZZ_CHECK(std::equal(file.data(), file.data() + file.size(), migrated_payload.begin(), migrated_payload.end()),
+               "the migrated payload differs from the module's migration");
+    const std::vector<uint8_t> written = read_all(image);
+    FUZZ_CHECK(host::EepromFile::validate(identity, written).ok(), "the migrated image file is not valid");
   } else {
     FUZZ_CHECK(file.load_outcome() == host::EepromLoadOutcome::kReplacedDamaged, "damaged (%s) but outcome %d",
                problem.c_str(), static_cast<int>(file.load_outcome()));

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -203,6 +204,9 @@ Result<std::unique_ptr<EepromFile>> EepromFile::open(const std::filesystem::path
     file->load_outcome_ = EepromLoadOutcome::kCreated;
   } else if (read_error != 0) {
     return Error{"cannot read EEPROM image " + path.string() + ": " + errno_text(read_error)};
+  } else if (std::optional<Result<void>> migrated = file->migrate_older_layout(bytes); migrated) {
+    if (!*migrated) return Error{migrated->error()};
+    return file;
   } else if (const Result<void> valid = validate(identity, bytes); !valid) {
     file->load_outcome_ = EepromLoadOutcome::kReplacedDamaged;
     log("motwin: EEPROM image " + path.string() + " is damaged (" + valid.error() + "); using factory defaults");
@@ -234,6 +238,31 @@ EepromFile::EepromFile(std::filesystem::path path, EepromImageIdentity identity,
 EepromFile::~EepromFile() {
   ::close(lock_fd_);
   ::close(directory_fd_);
+}
+
+// An image that is valid but for an older layout version the module can migrate: converted,
+// logged and written back at once. nullopt when this does not apply (the caller validates as
+// usual); an error only when the migrated image cannot be written.
+std::optional<Result<void>> EepromFile::migrate_older_layout(const std::vector<uint8_t>& bytes) {
+  if (!identity_.migrate_layout || bytes.size() < kHeaderSize) return std::nullopt;
+  const uint32_t stored_layout = get_u32(&bytes[kLayoutVersionOffset]);
+  if (stored_layout == identity_.layout_version) return std::nullopt;
+  EepromImageIdentity stored_identity = identity_;
+  stored_identity.layout_version = stored_layout;
+  if (!validate(stored_identity, bytes)) return std::nullopt;
+  std::vector<uint8_t> payload(bytes.begin() + kHeaderSize, bytes.end());
+  if (!identity_.migrate_layout(stored_layout, payload.data(), payload.size())) return std::nullopt;
+  image_ = std::move(payload);
+  recorded_firmware_ = recorded_firmware_of(bytes);
+  load_outcome_ = EepromLoadOutcome::kMigrated;
+  if (log_) {
+    log_("motwin: EEPROM image " + path_.string() + " has NVM layout " + std::to_string(stored_layout) +
+         "; migrated to layout " + std::to_string(identity_.layout_version));
+  }
+  if (const int error = persist(); error != 0) {
+    return Result<void>{Error{"cannot write EEPROM image " + path_.string() + ": " + errno_text(error)}};
+  }
+  return Result<void>{};
 }
 
 bool EepromFile::record_running_firmware() {

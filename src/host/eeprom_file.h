@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,10 @@ struct EepromImageIdentity {
   // recorded in every write. Another firmware's record is no damage: the module decides what
   // a firmware change does to the image (ModuleEeprom::open).
   std::string firmware_version = {};
+  // Brings the payload of an image of an older layout version (the argument) to layout_version
+  // in place; false when it cannot. Empty: every other layout version is foreign. A migrated
+  // image is rewritten at once with the new layout version (one log line says so).
+  std::function<bool(uint32_t stored_layout_version, uint8_t* payload, size_t size)> migrate_layout = {};
 };
 
 // Fills `image` (payload_size bytes) with the module's factory defaults.
@@ -52,6 +57,7 @@ enum class EepromLoadOutcome : uint8_t {
   kLoaded,           // the file was valid
   kCreated,          // there was no file: the factory image was written
   kReplacedDamaged,  // damaged or foreign: reported, kept as <path>.damaged, factory image written
+  kMigrated,         // an older layout version that identity.migrate_layout converted (and wrote)
 };
 
 // Steps of an atomic write, in order, for fault injection in tests.
@@ -120,6 +126,7 @@ class EepromFile final : public board::NonVolatileMemory {
 
  private:
   EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd, LogSink log);
+  std::optional<Result<void>> migrate_older_layout(const std::vector<uint8_t>& bytes);
   // Writes image_ to disk atomically; on failure returns the errno.
   int persist();
   int injected_fault(PersistStep step) const;

@@ -42,8 +42,15 @@ constexpr std::string_view default_firmware_of() {
 // and the firmware it records (by default the module's one version string).
 template <typename Device>
 EepromImageIdentity eeprom_identity_of(std::string_view firmware_version = default_firmware_of<Device>()) {
-  return EepromImageIdentity{std::string(Device::kName), Device::kNvmLayoutVersion, nvm_image_size_of<Device>(),
-                             std::string(firmware_version)};
+  EepromImageIdentity identity{std::string(Device::kName), Device::kNvmLayoutVersion, nvm_image_size_of<Device>(),
+                               std::string(firmware_version)};
+  // A module that can read its older layouts says so with a static migrate_image().
+  if constexpr (requires(uint8_t* image) { Device::migrate_image(uint32_t{1}, image, size_t{0}); }) {
+    identity.migrate_layout = [](uint32_t stored_layout_version, uint8_t* payload, size_t size) {
+      return Device::migrate_image(stored_layout_version, payload, size);
+    };
+  }
+  return identity;
 }
 
 // What starting another firmware on an existing image does to it, before the firmware powers up
