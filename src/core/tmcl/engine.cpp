@@ -154,7 +154,15 @@ CommandResult TmclEngine::control_command(const Instruction& in) {
 
 // The steps of one instruction: download mode stores it, the program-control commands and the
 // interrupt bank are the engine's own, everything else goes to its command family.
+// Every failed command, from a host or a program, leaves its status for GP 131 of the modules
+// that list it (the TMCM-142). A wrong checksum never reaches the engine (the links answer it).
 CommandResult TmclEngine::execute(const Instruction& in, Origin origin, ChannelId channel) {
+  const CommandResult result = dispatch(in, origin, channel);
+  if (!is_success(to_byte(result.status))) device_.runtime().last_error = to_byte(result.status);
+  return result;
+}
+
+CommandResult TmclEngine::dispatch(const Instruction& in, Origin origin, ChannelId channel) {
   if (origin == Origin::kHost && device_.runtime().download_mode && !is_control_command(in.command)) {
     return store_downloaded(in);
   }

@@ -79,6 +79,7 @@ class TmclEngine {
   uint32_t power_up_count() const { return power_up_count_; }
 
  private:
+  CommandResult dispatch(const Instruction& instruction, Origin origin, ChannelId channel);
   struct PendingEvent {
     bool active = false;
     ChannelId channel = 0;

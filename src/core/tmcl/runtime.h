@@ -30,14 +30,17 @@ struct TmclRuntime {
   uint32_t program_counter = 0;
   bool download_mode = false;       // GP 129
   uint32_t download_address = 0;    // next address a downloaded instruction goes to
+  uint8_t last_error = 0;           // status of the last failed command (TMCM-142 GP 131), 0: none
 
-  // Command 131: registers, flags and program counter cleared (download state kept).
+  // Command 131: registers, flags and program counter cleared (download state and last error kept).
   void clear_registers() {
     const bool download = download_mode;
     const uint32_t address = download_address;
+    const uint8_t error = last_error;
     *this = TmclRuntime{};
     download_mode = download;
     download_address = address;
+    last_error = error;
   }
 };
 
