@@ -724,6 +724,11 @@ def eeprom_seeds(motwin):
         struct.pack_into("<I", header, 52, 16)
         struct.pack_into("<I", header, 60, zlib.crc32(bytes(header[:60])) & 0xFFFFFFFF)
         write("eeprom_image", f"{module}_other_payload_size", prefix + bytes(header) + good[64:80])
+    # A TMCM-142 image of NVM layout 1 (the numbering before the real module's), which the loader
+    # migrates (tests/data/README.md).
+    with open(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests", "data",
+                           "tmcm142_nvm_layout1.eeprom"), "rb") as f:
+        write("eeprom_image", "tmcm-142_nvm_layout1", b"\1" + f.read())
     # Another module's valid image (TMCM-142 bytes as the TMCM-1636's file).
     with open(os.path.join(CORPUS, "eeprom_image", "tmcm-142_factory"), "rb") as f:
         write("eeprom_image", "tmcm-142_image_for_tmcm-1636", b"\0" + f.read()[1:])

@@ -50,8 +50,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       continue;
     }
     const tmcl::Instruction instruction = fuzz::next_instruction<Tmcm142>(in);
-    // GP 133 (random number) reads a new value each time: no "unchanged" to compare.
-    const bool is_set = instruction.command == 5 || (instruction.command == 9 && instruction.type != 133);
+    // GP 133 (random number) reads a new value each time, AP 44 and 207 are cleared by reading and
+    // GP 131 (last TMCL error) records the refusal itself: no "unchanged" to compare.
+    const bool is_set = (instruction.command == 5 && instruction.type != 44 && instruction.type != 207) ||
+                        (instruction.command == 9 && instruction.type != 133 && instruction.type != 131);
     fuzz::execute_checked(*rig->module, engine, instruction, is_set);
     fuzz::check_parameter_ranges(*rig->module, "after an instruction");
   }

@@ -4,7 +4,7 @@ started with MOTWIN_CRASH_AT_PERSIST_STEP=STEP (docs/host-runtime.md) SIGKILLs i
 STEP of its first EEPROM image write.
 
 Kinds of write: TMCM-1636 STAP (AP 43), STGP (user variable 5) and program download (132, four
-CALC, 133); TMCM-142 STAP (AP 214) and SCO n, 255 (a coordinate into the EEPROM); TMCM-3216 1010
+CALC, 133); TMCM-142 STAP (AP 20, standby delay) and SCO n, 255 (a coordinate into the EEPROM); TMCM-3216 1010
 sub 1 "save" (after 1017 = k) and LSS store configuration (after configure node ID). Steps:
 open-temporary, write-temporary, sync-temporary, rename, sync-directory. For each pair, starting
 from an image holding the old value:
@@ -153,19 +153,19 @@ class Tmcm1636Download(TmclStore):
 
 class Tmcm142Stap(TmclStore):
     test_name = "tmcm142_stap"
-    name = "TMCM-142 STAP 214"
+    name = "TMCM-142 STAP 20"
     server_class = Tmcm142Server
     image_name = "tmcm-142.eeprom"
     old, new = 300, 450
 
     def set_value(self, c, value):
-        c.sap(214, value)
+        c.sap(20, value)
 
     def store_frame(self):
-        return frame(STAP, 214)
+        return frame(STAP, 20)
 
     def read_value(self, c):
-        return c.gap(214)
+        return c.gap(20)
 
 
 class Tmcm142StoredCoordinate(TmclStore):

@@ -271,15 +271,15 @@ def coordinate(c, number, motor=0):
 
 
 def test_full_disk_tmcm142(motwin):
-    """STAP (AP 214), STGP, SCO n, 255 (copy to the EEPROM), the auto-stored SGP 84, 133 and, with
+    """STAP (AP 20), STGP, SCO n, 255 (copy to the EEPROM), the auto-stored SGP 84, 133 and, with
     GP 84 = 1, an SCO that stores at once: status 5, RAM as the manual's rollback says, the image
     byte for byte as it was; a restart without the limit loads the old values."""
     with TempDir() as tmp:
         state = os.path.join(tmp, "state")
         with Tmcm142Server(motwin, state) as server:
             with server.tcp() as c:
-                c.sap(214, 300)
-                c.stap(214)
+                c.sap(20, 300)
+                c.stap(20)
                 c.sgp(5, BANK_USER, 11)
                 c.stgp(5, BANK_USER)
                 c.ok(SCO, 3, 0, 1000, what="SCO 3, 0, 1000")
@@ -292,7 +292,7 @@ def test_full_disk_tmcm142(motwin):
         # GP 84 = 0: coordinates live in RAM, SCO n, 255 copies one into the EEPROM.
         with on_full_disk(Tmcm142Server(motwin, state), before) as server:
             with server.tcp() as c:
-                check_stap_stgp_and_download_refused(c, 214, 300, 450)
+                check_stap_stgp_and_download_refused(c, 20, 300, 450)
                 c.ok(SCO, 3, 0, 3000, what="SCO 3, 0, 3000 (RAM)")
                 expect_reply(c.request(SCO, 3, COORDINATE_EEPROM_COPY), SCO, STATUS_EEPROM,
                              what="SCO 3, 255 on a full disk")
@@ -318,13 +318,13 @@ def test_full_disk_tmcm142(motwin):
                 expect_reply(c.request(SCO, 4, 0, 2000), SCO, STATUS_EEPROM, what="stored SCO 4 on a full disk")
                 check_equal(coordinate(c, 4), 0, "coordinate 4 rolled back after the failed store")
                 check_failed_stores_left_no_trace(server, state, image, before)
-                check_equal(c.gap(214), 300, "the server still serves")
+                check_equal(c.gap(20), 300, "the server still serves")
             server.stop()
 
         with Tmcm142Server(motwin, state) as server:
             check_clean_restart(server, state, "after the full disk")
             with server.tcp() as c:
-                check_equal(c.gap(214), 300, "AP 214 after the restart")
+                check_equal(c.gap(20), 300, "AP 20 after the restart")
                 check_equal(c.ggp(5, BANK_USER), 11, "user variable 5 after the restart")
                 check_equal((coordinate(c, 3), coordinate(c, 4)), (1000, 0), "coordinates 3, 4 after the restart")
                 check_equal(read_program_values(c), [7] * PROGRAM_LENGTH, "program after the restart")

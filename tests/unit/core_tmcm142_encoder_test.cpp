@@ -1,4 +1,4 @@
-// TMCM-142 on the physical NEMA23 model: the encoder position (AP 41, 42, 46), lost steps on a
+// TMCM-142 on the physical NEMA23 model: the encoder position (AP 41, 42, 43), lost steps on a
 // blocked rotor, the encoder deviation stop (AP 212, AP 207, EDV for JC and CLE) and the easyPID
 // correcting a load-induced lag.
 #include <cmath>
@@ -26,7 +26,7 @@ void use_pps(Tmcm142Rig& rig, int32_t vmax, int32_t acceleration) {
   ASSERT_EQ(rig.sap(255, 1), kOk);
   ASSERT_EQ(rig.sap(4, vmax), kOk);
   ASSERT_EQ(rig.sap(5, acceleration), kOk);
-  ASSERT_EQ(rig.sap(214, 65535), kOk);  // keep the run current at rest
+  ASSERT_EQ(rig.sap(20, 65535), kOk);  // standby delay: keep the run current at rest
 }
 
 TEST(Tmcm142Encoder, encoder_position_follows_the_rotor_in_either_direction) {
@@ -39,7 +39,7 @@ TEST(Tmcm142Encoder, encoder_position_follows_the_rotor_in_either_direction) {
   EXPECT_NEAR(rig.gap(41), 20480, 52);
   EXPECT_NEAR(rig.rotor_microsteps(), 20480.0, 80.0);
   ASSERT_EQ(rig.sap(41, 0), kOk);
-  ASSERT_EQ(rig.sap(46, 1), kOk);
+  ASSERT_EQ(rig.sap(43, 1), kOk);  // encoder mode bit 0: count the other way
   ASSERT_EQ(rig.command(4, 0, 0, 40960).status, kOk);
   rig.run_until([&] { return rig.gap(8) == 1; }, 3000);
   rig.run_ms(300);

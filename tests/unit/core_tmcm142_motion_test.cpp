@@ -24,7 +24,7 @@ void use_pps(Tmcm142Rig& rig, int32_t vmax, int32_t acceleration) {
   ASSERT_EQ(rig.sap(255, 1), kOk);
   ASSERT_EQ(rig.sap(4, vmax), kOk);
   ASSERT_EQ(rig.sap(5, acceleration), kOk);
-  for (uint8_t bow = 16; bow <= 19; ++bow) ASSERT_EQ(rig.sap(bow, modules::tmcm142::kMaxBow), kOk);
+  ASSERT_EQ(rig.sap(18, modules::tmcm142::kMaxBow), kOk);  // max. bow: trapezoid
 }
 
 TEST(Tmcm142Motion, moves_the_rotor_exactly_to_the_target_and_drops_to_standby_current) {
@@ -40,7 +40,7 @@ TEST(Tmcm142Motion, moves_the_rotor_exactly_to_the_target_and_drops_to_standby_c
   EXPECT_EQ(rig.gap(3), 0);
   EXPECT_NEAR(rig.rotor_microsteps(), 51200.0, 0.01);
   EXPECT_EQ(rig.gap(129) & 0b101, 0b101);  // position reached, velocity zero
-  rig.run_ms(2100);                          // AP 214 = 200: 2 s at rest
+  rig.run_ms(2100);                          // AP 20 = 200: 2 s at rest
   EXPECT_NEAR(coil_amplitude_ma(rig.stage.drive), 875.0, 3.0);  // standby, AP 7 = 1
   EXPECT_NEAR(rig.rotor_microsteps(), 51200.0, 0.01);
 }

@@ -51,10 +51,11 @@ TEST(Tmcm142Parameters, every_stored_parameter_reads_its_default_after_power_up)
 TEST(Tmcm142Parameters, motwin_decisions_are_tagged) {
   int decisions = 0;
   for (const auto& row : Tmcm142::axis_parameters().rows()) decisions += params::is_motwin_decision(row.info.description) ? 1 : 0;
-  // Bows 16..19, P and I (30, 31), encoder direction (46), standby delay (214), switch mode bits (14).
-  EXPECT_EQ(decisions, 9);
-  EXPECT_TRUE(params::is_motwin_decision(Tmcm142::axis_parameters().find(16)->info.description));
+  // What no public page gives: 9, 14, 16, 17, 18, 20..23, 26, 28..31, 43, 44, 47, 48, 63, 64.
+  EXPECT_EQ(decisions, 20);
+  EXPECT_TRUE(params::is_motwin_decision(Tmcm142::axis_parameters().find(18)->info.description));
   EXPECT_FALSE(params::is_motwin_decision(Tmcm142::axis_parameters().find(4)->info.description));
+  EXPECT_FALSE(params::is_motwin_decision(Tmcm142::axis_parameters().find(212)->info.description));
 }
 
 TEST(Tmcm142Parameters, motwin_params_lists_the_table_with_the_decisions_marked) {
@@ -63,8 +64,8 @@ TEST(Tmcm142Parameters, motwin_params_lists_the_table_with_the_decisions_marked)
   const host::ModuleParameterListing listing = source->listing();
   ASSERT_EQ(listing.sections.size(), 3u);
   const std::string table = tools::format_parameter_listing(listing, tools::ListingFormat::kTable);
-  EXPECT_NE(table.find("[Motwin decision] jerk building up the acceleration"), std::string::npos);
-  EXPECT_NE(table.find("max positioning speed"), std::string::npos);
+  EXPECT_NE(table.find("[Motwin decision] jerk of all four changes of acceleration"), std::string::npos);
+  EXPECT_NE(table.find("max velocity"), std::string::npos);
   EXPECT_NE(table.find("0..55"), std::string::npos);  // storable user variables
 }
 
@@ -81,8 +82,9 @@ TEST(Tmcm142Parameters, bad_values_answer_their_status_and_change_nothing) {
   EXPECT_EQ(rig.sap(5, 0), kInvalidValue);
   EXPECT_EQ(rig.sap(16, 0), kInvalidValue);
   EXPECT_EQ(rig.sap(3, 5), kWrongType);        // read-only
-  EXPECT_EQ(rig.sap(9, 5), kWrongType);        // no such parameter
-  EXPECT_EQ(rig.command(6, 9, 0, 0).status, kWrongType);
+  EXPECT_EQ(rig.sap(9, 5), kWrongType);        // switch status: read-only
+  EXPECT_EQ(rig.sap(24, 5), kWrongType);       // no such parameter (the real list skips 24, 25)
+  EXPECT_EQ(rig.command(6, 24, 0, 0).status, kWrongType);
   EXPECT_EQ(rig.command(5, 4, 1, 100).status, kInvalidValue);  // motor 1
   EXPECT_EQ(rig.command(7, 0, 0, 0).status, kWrongType);        // STAP of a parameter without E
   EXPECT_EQ(rig.gap(6), 5);

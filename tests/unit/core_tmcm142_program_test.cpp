@@ -33,7 +33,7 @@ void use_pps(Tmcm142Rig& rig, int32_t vmax, int32_t acceleration) {
   ASSERT_EQ(rig.sap(255, 1), kOk);
   ASSERT_EQ(rig.sap(4, vmax), kOk);
   ASSERT_EQ(rig.sap(5, acceleration), kOk);
-  for (uint8_t bow = 16; bow <= 19; ++bow) ASSERT_EQ(rig.sap(bow, modules::tmcm142::kMaxBow), kOk);
+  ASSERT_EQ(rig.sap(18, modules::tmcm142::kMaxBow), kOk);  // max. bow: trapezoid
 }
 
 // Program: tick timer before (var 1) and after (var 2) `WAIT condition, 0, 5` (50 ms), then

@@ -22,17 +22,13 @@ void use_pps(Tmcm142Rig& rig, int32_t vmax, int32_t acceleration) {
   ASSERT_EQ(rig.sap(5, acceleration), kOk);
 }
 
-void set_bows(Tmcm142Rig& rig, int32_t b16, int32_t b17, int32_t b18, int32_t b19) {
-  ASSERT_EQ(rig.sap(16, b16), kOk);
-  ASSERT_EQ(rig.sap(17, b17), kOk);
-  ASSERT_EQ(rig.sap(18, b18), kOk);
-  ASSERT_EQ(rig.sap(19, b19), kOk);
-}
+// AP 18, the module's one bow, for all four changes of acceleration.
+void set_max_bow(Tmcm142Rig& rig, int32_t bow) { ASSERT_EQ(rig.sap(18, bow), kOk); }
 
 TEST(Tmcm142Ramp, maximum_bows_give_the_trapezoid_time) {
   Tmcm142Rig rig;
   use_pps(rig, 100000, 1000000);
-  set_bows(rig, 16777215, 16777215, 16777215, 16777215);
+  set_max_bow(rig, 16777215);
   ASSERT_EQ(rig.command(4, 0, 0, 200000).status, kOk);
   rig.run_ms(1);
   // A trapezoid corner: the full acceleration from the first tick.
@@ -46,8 +42,8 @@ TEST(Tmcm142Ramp, maximum_bows_give_the_trapezoid_time) {
 TEST(Tmcm142Ramp, default_bows_add_a_over_j_to_the_move_time) {
   Tmcm142Rig rig;
   use_pps(rig, 100000, 1000000);
-  // Factory bows 1000: J = 1000 * 64e6^3 / 2^64 = 14210855 µsteps/s³ in all four phases.
-  EXPECT_EQ(rig.gap(16), 1000);
+  // Factory bow 1000: J = 1000 * 64e6^3 / 2^64 = 14210855 µsteps/s³ in all four phases.
+  EXPECT_EQ(rig.gap(18), 1000);
   const double jerk = 1000 * hw::kPps3PerBowUnit;
   EXPECT_NEAR(jerk, 14210855.0, 1.0);
   ASSERT_EQ(rig.command(4, 0, 0, 200000).status, kOk);
@@ -57,27 +53,30 @@ TEST(Tmcm142Ramp, default_bows_add_a_over_j_to_the_move_time) {
   EXPECT_EQ(rig.gap(1), 200000);
 }
 
-// Four different bows: each phase of the S-curve has exactly its own jerk, the acceleration
-// stays within AMAX and the velocity within VMAX.
-TEST(Tmcm142Ramp, each_bow_limits_the_jerk_of_its_phase) {
+// AP 18 limits the jerk of each of the four phases of the S-curve, AP 17 the deceleration; the
+// acceleration stays within AMAX (AP 5) and the velocity within VMAX.
+TEST(Tmcm142Ramp, max_bow_limits_the_jerk_of_every_phase_and_ap_17_the_deceleration) {
   Tmcm142Rig rig;
   use_pps(rig, 200000, 1000000);
-  set_bows(rig, 500, 1000, 2000, 4000);
-  const double bow_pps3[4] = {500 * hw::kPps3PerBowUnit, 1000 * hw::kPps3PerBowUnit, 2000 * hw::kPps3PerBowUnit,
-                              4000 * hw::kPps3PerBowUnit};
+  set_max_bow(rig, 500);
+  ASSERT_EQ(rig.sap(17, 500000), kOk);
+  EXPECT_EQ(rig.gap(16), 1000000) << "AP 16 is AP 5";
+  const double bow_pps3 = 500 * hw::kPps3PerBowUnit;
   ASSERT_EQ(rig.command(4, 0, 0, 600000).status, kOk);
   double peak_jerk[4] = {0, 0, 0, 0};
   double peak_acceleration = 0.0;
+  double peak_deceleration = 0.0;
   double peak_velocity = 0.0;
   double last_acceleration = 0.0;
   bool braking = false;
-  for (int tick = 0; tick < 5 * 20000 && rig.gap(8) == 0; ++tick) {
+  for (int tick = 0; tick < 8 * 20000 && rig.gap(8) == 0; ++tick) {
     rig.tick();
     const auto& ramp = rig.module.axis().ramp();
     const double a = ramp.acceleration();
     const double jerk = (a - last_acceleration) / hw::kControlTickS;
     last_acceleration = a;
-    peak_acceleration = std::max(peak_acceleration, std::fabs(a));
+    peak_acceleration = std::max(peak_acceleration, a);
+    peak_deceleration = std::max(peak_deceleration, -a);
     peak_velocity = std::max(peak_velocity, ramp.velocity());
     // Phases: build-up of acceleration, its reduction, build-up of deceleration, its reduction.
     if (a < 0.0) braking = true;
@@ -89,11 +88,14 @@ TEST(Tmcm142Ramp, each_bow_limits_the_jerk_of_its_phase) {
   EXPECT_EQ(rig.gap(8), 1);
   EXPECT_EQ(rig.gap(1), 600000);
   EXPECT_LE(peak_acceleration, 1000000.0 * (1 + 1e-9));
-  EXPECT_GE(peak_acceleration, 1000000.0 * (1 - 1e-9)) << "AMAX is reached with these bows";
+  EXPECT_GE(peak_acceleration, 1000000.0 * (1 - 1e-9)) << "AMAX is reached with this bow";
+  EXPECT_LE(peak_deceleration, 500000.0 * (1 + 1e-9));
+  // The braking peak is chosen to end exactly on the target: DMAX within 0.1 %, far from AMAX.
+  EXPECT_GE(peak_deceleration, 500000.0 * 0.999) << "DMAX (AP 17) is reached";
   EXPECT_LE(peak_velocity, 200000.0 * (1 + 1e-9));
   for (int k = 0; k < 4; ++k) {
-    EXPECT_LE(peak_jerk[k], bow_pps3[k] * 1.0001) << "AP " << 16 + k;
-    EXPECT_GE(peak_jerk[k], bow_pps3[k] * 0.99) << "AP " << 16 + k;
+    EXPECT_LE(peak_jerk[k], bow_pps3 * 1.0001) << "phase " << k;
+    EXPECT_GE(peak_jerk[k], bow_pps3 * 0.99) << "phase " << k;
   }
 }
 
@@ -102,7 +104,7 @@ TEST(Tmcm142Ramp, each_bow_limits_the_jerk_of_its_phase) {
 TEST(Tmcm142Ramp, hold_mode_keeps_the_velocity_and_ap_130_follows_the_mode) {
   Tmcm142Rig rig;
   use_pps(rig, 100000, 100000);
-  set_bows(rig, 16777215, 16777215, 16777215, 16777215);
+  set_max_bow(rig, 16777215);
   ASSERT_EQ(rig.command(1, 0, 0, 50000).status, kOk);  // ROR 50000: 0.5 s to reach it
   rig.run_ms(200);
   EXPECT_EQ(rig.gap(128), 2);
@@ -132,7 +134,7 @@ TEST(Tmcm142Ramp, hold_mode_keeps_the_velocity_and_ap_130_follows_the_mode) {
 TEST(Tmcm142Ramp, velocity_reached_in_position_mode_at_vmax_and_on_the_target) {
   Tmcm142Rig rig;
   use_pps(rig, 100000, 1000000);
-  set_bows(rig, 16777215, 16777215, 16777215, 16777215);
+  set_max_bow(rig, 16777215);
   ASSERT_EQ(rig.command(4, 0, 0, 100000).status, kOk);  // 1.1 s: 0.1 s up, 0.9 s at VMAX, 0.1 s down
   rig.run_ms(50);
   EXPECT_EQ(rig.gap(130), 0) << "accelerating";

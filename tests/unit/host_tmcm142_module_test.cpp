@@ -206,7 +206,7 @@ TEST(Tmcm142Module, a_limit_switch_soft_stop_decelerates_past_the_switch) {
   ASSERT_EQ(execute(m, kMvp, 0, kRev).status, tmcl::Status::kOk);
   run_ms(m, 2000);
   const int32_t stop = gap(m, 1);
-  // v²/2a is 0.05 rev; the S-shaped onset of the deceleration (bows 1000) adds about 0.14 s of it.
+  // v²/2a is 0.05 rev; the S-shaped onset of the deceleration (max. bow 1000) adds about 0.14 s of it.
   EXPECT_GT(stop, kRev / 2 + kRev / 20);
   EXPECT_LT(stop, kRev / 2 + kRev / 4);
   EXPECT_EQ(gap(m, 3), 0);
@@ -319,7 +319,7 @@ TEST(Tmcm142Module, encoder_resolution_and_direction_come_from_the_signals) {
   Made made = make("ideal", {{"ENCODER_CPR", 1000}, {"ENCODER_REVERSED", 1}});
   VirtualModule& m = **made.result;
   sap(m, 42, 13421773);  // 204.8 µsteps per count: 1000 counts per revolution
-  sap(m, 46, 1);         // and count the other way, as the encoder is reversed
+  sap(m, 43, 1);         // and count the other way (encoder mode bit 0), as the encoder is reversed
   ASSERT_EQ(execute(m, kMvp, 0, kRev).status, tmcl::Status::kOk);
   run_until_reached(m, 3000);
   EXPECT_EQ(gap(m, 1), kRev);

@@ -21,6 +21,58 @@ constexpr uint8_t kApUnitMode = 255;
 
 }  // namespace
 
+// Layout 1 -> 2 (docs/tmcm-142.md "EEPROM image"): the slots are the parameter numbers, so the
+// values of the renumbered settings move, the slots whose meaning changed get the new meaning's
+// factory value, and the rows new in layout 2 start at their defaults.
+bool Tmcm142::migrate_image(uint32_t from_layout_version, uint8_t* image, size_t size) {
+  constexpr tmcl::NvmLayout layout = kNvmLayout;
+  if (from_layout_version != 1 || size != layout.total_size) return false;
+  const auto axis_slot = [&](uint8_t number) { return image + layout.axis_parameter(0, number); };
+  // The stored axis rows of layout 1; every other stored row of layout 2 is new.
+  constexpr uint8_t kLayout1AxisRows[] = {4,  5,  6,  7,  12, 13, 14,  15,  16,  17,  18,  19,  27, 30,
+                                          31, 32, 33, 35, 37, 40, 42, 46, 193, 194, 195, 212, 214, 255};
+  constexpr uint8_t kLayout1BowSlots[] = {16, 17, 18, 19};
+  constexpr uint8_t kLayout1EncoderDirection = 46;
+  constexpr uint8_t kLayout1StandbyDelay = 214;
+
+  // One bow for the four: the gentlest of the stored ones, so no change of acceleration becomes
+  // harsher than it was set.
+  int32_t bow = kMaxBow;
+  bool any_bow = false;
+  for (const uint8_t slot : kLayout1BowSlots) {
+    const int32_t value = tmcl::get_le32(axis_slot(slot));
+    if (value < 1 || value > kMaxBow) continue;
+    if (!any_bow || value < bow) bow = value;
+    any_bow = true;
+  }
+  const int32_t encoder_reversed = tmcl::get_le32(axis_slot(kLayout1EncoderDirection)) == 1 ? encoder_mode::kReverse : 0;
+  const int32_t standby_delay = tmcl::get_le32(axis_slot(kLayout1StandbyDelay));
+
+  for (const auto& row : axis_parameters().rows()) {
+    if (!tmcl::is_stored_parameter(row.info)) continue;
+    bool in_layout1 = false;
+    for (const uint8_t number : kLayout1AxisRows) in_layout1 = in_layout1 || number == row.info.number;
+    if (!in_layout1 || row.info.number == 17 || row.info.number == 18 || row.info.number == 19) {
+      tmcl::put_le32(axis_slot(static_cast<uint8_t>(row.info.number)), static_cast<int32_t>(row.info.default_value));
+    }
+  }
+  // Slots no stored row of layout 2 reads any more: cleared, as a factory image has them.
+  tmcl::put_le32(axis_slot(16), 0);
+  tmcl::put_le32(axis_slot(kLayout1EncoderDirection), 0);
+  tmcl::put_le32(axis_slot(kLayout1StandbyDelay), 0);
+  constexpr uint8_t kMaxBowRow = 18, kStandbyDelayRow = 20, kEncoderModeRow = 43;
+  if (any_bow) tmcl::put_le32(axis_slot(kMaxBowRow), bow);
+  tmcl::put_le32(axis_slot(kStandbyDelayRow), standby_delay);
+  tmcl::put_le32(axis_slot(kEncoderModeRow), encoder_reversed);
+
+  constexpr uint8_t kLayout2NewGlobals[] = {68, 81, 82, 83, 87};
+  for (const uint8_t number : kLayout2NewGlobals) {
+    const auto* row = global_parameters().find(number);
+    if (row != nullptr) tmcl::put_le32(image + layout.global_parameter(number), static_cast<int32_t>(row->info.default_value));
+  }
+  return true;
+}
+
 // Power-up: what the base clears, the EEPROM lock and the coordinates, before the restore.
 void Tmcm142::clear_ram_state() {
   TmclModule::clear_ram_state();

@@ -43,6 +43,12 @@ struct GlobalConfig {
   int32_t auto_start_mode = 1;         // GP 77
   CoordinateStorage coordinate_storage = CoordinateStorage::kRam;  // GP 84: RAM copies on request
   int32_t skip_user_variable_restore = 0;  // GP 85
+  // Stored only (docs/tmcm-142.md "Global parameters (bank 0)").
+  int32_t serial_heartbeat_ms = 0;       // GP 68
+  int32_t code_protection = 0;           // GP 81
+  int32_t can_heartbeat_ms = 0;          // GP 82
+  int32_t can_secondary_id = 0;          // GP 83
+  int32_t serial_secondary_address = 0;  // GP 87
 };
 
 inline constexpr size_t kStorableUserVariables = 56;  // 0..55
@@ -56,7 +62,8 @@ inline constexpr tmcl::ModuleFacts kFacts{
     .name = "tmcm-142",
     .identity = {142, 1, 6, "142V1.06"},
     .nvm_layout = tmcl::make_nvm_layout(1, kStorableUserVariables, kProgramCapacity, kCoordinateCount),
-    .nvm_layout_version = 1,
+    // 2: the real module's numbering (docs/tmcm-142.md "EEPROM image"); migrate_image() takes 1.
+    .nvm_layout_version = 2,
     .control_tick_us = kControlTickUs,
     // ROR/ROL write the target speed (AP 2) in the units of AP 255, MVP the target position (AP 0).
     .motion = {.target_position = 0, .target_velocity = 2},
@@ -73,6 +80,10 @@ class Tmcm142 final : public tmcl::TmclModule<Tmcm142, Tmcm142Axis, GlobalConfig
 
   static const Table& axis_parameters();
   static const Table& global_parameters();  // bank 0
+  // Brings an image of an older NVM layout (`from_layout_version`) to kNvmLayoutVersion in place:
+  // layout 1 numbered four bows AP 16..19, the encoder direction AP 46 and the standby delay
+  // AP 214. False for a version it does not know or an image of the wrong size (left unchanged).
+  static bool migrate_image(uint32_t from_layout_version, uint8_t* image, size_t size);
   // format_factory_image(image, size): tmcl::ModuleStorage.
 
   board::StepperPowerStage& power_stage() { return stage_; }

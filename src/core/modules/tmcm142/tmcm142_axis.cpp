@@ -44,7 +44,14 @@ void Tmcm142Axis::set_target_position(int32_t position) {
   search_.stop();
   search_final_move_ = false;
   switch_stopping_ = false;
-  ramp_.set_position_target(position);
+  ramp_.set_position_target(clipped_to_position_limits(position));
+}
+
+// AP 50..53: a target beyond an enabled position limit ends on the limit (Motwin decision).
+int32_t Tmcm142Axis::clipped_to_position_limits(int32_t target) const {
+  if (config.right_position_limit_enable != 0 && target > config.right_position_limit) return config.right_position_limit;
+  if (config.left_position_limit_enable != 0 && target < config.left_position_limit) return config.left_position_limit;
+  return target;
 }
 
 void Tmcm142Axis::set_actual_position(int32_t position) {
@@ -92,8 +99,43 @@ int32_t Tmcm142Axis::status_flags() const {
   if (position_reached()) flags |= status_flag::kPositionReached;
   if (velocity_reached()) flags |= status_flag::kVelocityReached;
   if (ramp_.standstill()) flags |= status_flag::kStandstill;
-  if (state.deviation_exceeded) flags |= status_flag::kEncoderDeviation;
+  if (state.deviation_exceeded || encoder_warning()) flags |= status_flag::kEncoderWarning;
   return flags;
+}
+
+int32_t Tmcm142Axis::encoder_deviation() const {
+  return static_cast<int32_t>(static_cast<uint32_t>(state.encoder_position) - static_cast<uint32_t>(ramp_.position()));
+}
+
+// AP 47: |AP 41 - AP 1| beyond the warn distance (0 = off) sets AP 129 bit 3 (V1.06 manual).
+bool Tmcm142Axis::encoder_warning() const {
+  if (config.encoder_warn_distance <= 0) return false;
+  const int64_t difference = encoder_deviation();
+  return (difference < 0 ? -difference : difference) > config.encoder_warn_distance;
+}
+
+int32_t Tmcm142Axis::switch_status() const {
+  return state.right_switch_active | (state.left_switch_active << 1) | (state.home_switch_active << 2);
+}
+
+int32_t Tmcm142Axis::driver_status() const {
+  int32_t status = 0;
+  if (state.standby) status |= driver_status::kStandby;
+  if (state.supply_millivolt < kMinimumSupplyMillivolt) status |= driver_status::kUndervoltage;
+  if (state.compare_output) status |= driver_status::kCompareOutput;
+  return status;
+}
+
+// The sequencer's entry in the driver's sine table: 1024 per full step, 4096 per electrical
+// period (the whole table), whatever AP 27 selects.
+int32_t Tmcm142Axis::microstep_table_position() const {
+  return static_cast<int32_t>(last_drive_angle_ / (board::kElectricalAnglePerFullStep / 1024u));
+}
+
+int32_t Tmcm142Axis::take_encoder_status() {
+  const int32_t status = state.encoder_status;
+  state.encoder_status &= ~encoder_status::kLatched;
+  return status;
 }
 
 int32_t Tmcm142Axis::take_error_flags() {
@@ -134,13 +176,41 @@ void Tmcm142Axis::read_feedback(const board::StepperFeedback& feedback) {
   if (!encoder_.started) {
     encoder_.started = true;
     encoder_.last_count = feedback.encoder_count;
+    encoder_.index_events = feedback.encoder_index_events;  // pulses before power-up latch nothing
   }
   int64_t counts = static_cast<int32_t>(static_cast<uint32_t>(feedback.encoder_count) - static_cast<uint32_t>(encoder_.last_count));
   encoder_.last_count = feedback.encoder_count;
-  if (config.encoder_direction != 0) counts = -counts;
+  if (counts_reversed()) counts = -counts;
   encoder_.position_q16 += counts * config.encoder_constant;
   // Nearest microstep; the 32-bit register wraps.
   state.encoder_position = static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>((encoder_.position_q16 + 32768) >> 16)));
+  latch_on_null_channel(feedback);
+  state.supply_millivolt = feedback.supply_millivolt;
+}
+
+// AP 43 bit 0 and AP 19 each reverse the count: a mirrored shaft turns the encoder with it.
+bool Tmcm142Axis::counts_reversed() const {
+  return ((config.encoder_mode & encoder_mode::kReverse) != 0) != (config.shaft != 0);
+}
+
+// AP 43 bits 1, 2: at an N pulse the encoder position (at the count the pulse latched) goes to
+// AP 45 and the actual position to AP 46, AP 44 bit 0 is set; with bit 2 the encoder counter
+// then restarts from 0 at that count.
+void Tmcm142Axis::latch_on_null_channel(const board::StepperFeedback& feedback) {
+  const bool pulse = feedback.encoder_index_events != encoder_.index_events;
+  encoder_.index_events = feedback.encoder_index_events;
+  if (!pulse || (config.encoder_mode & encoder_mode::kLatchOnNull) == 0) return;
+  int64_t since_pulse = static_cast<int32_t>(static_cast<uint32_t>(feedback.encoder_count) -
+                                             static_cast<uint32_t>(feedback.encoder_index_count));
+  if (counts_reversed()) since_pulse = -since_pulse;
+  const int64_t at_pulse_q16 = encoder_.position_q16 - since_pulse * config.encoder_constant;
+  state.encoder_latch = static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>((at_pulse_q16 + 32768) >> 16)));
+  state.position_latch = ramp_.position();
+  state.encoder_status |= encoder_status::kLatched;
+  if ((config.encoder_mode & encoder_mode::kClearOnNull) != 0) {
+    encoder_.position_q16 = since_pulse * config.encoder_constant;
+    state.encoder_position = static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>((encoder_.position_q16 + 32768) >> 16)));
+  }
 }
 
 void Tmcm142Axis::run_reference_search() {
@@ -177,10 +247,15 @@ void Tmcm142Axis::run_reference_search() {
 }
 
 // A closed, enabled limit switch stops motion towards it: with AP 15 (AP 14 bit 5), else at once.
+// An enabled position limit (AP 50..53) reached or passed stops motion beyond it the same way.
 void Tmcm142Axis::apply_switch_stops() {
   const double v = ramp_.velocity();
-  const bool right_blocks = v > 0.0 && state.right_switch_active != 0 && config.right_switch_disable == 0;
-  const bool left_blocks = v < 0.0 && state.left_switch_active != 0 && config.left_switch_disable == 0;
+  const int32_t position = ramp_.position();
+  const bool right_limit = config.right_position_limit_enable != 0 && position >= config.right_position_limit;
+  const bool left_limit = config.left_position_limit_enable != 0 && position <= config.left_position_limit;
+  const bool right_blocks =
+      v > 0.0 && ((state.right_switch_active != 0 && config.right_switch_disable == 0) || right_limit);
+  const bool left_blocks = v < 0.0 && ((state.left_switch_active != 0 && config.left_switch_disable == 0) || left_limit);
   if (!right_blocks && !left_blocks) return;
   if ((config.switch_mode & switch_mode::kSoftStop) != 0) {
     if (!switch_stopping_) {
@@ -199,8 +274,7 @@ void Tmcm142Axis::apply_switch_stops() {
 
 // AP 212: encoder and actual position further apart than allowed stop the motor at once.
 void Tmcm142Axis::check_deviation() {
-  const auto difference =
-      static_cast<int32_t>(static_cast<uint32_t>(state.encoder_position) - static_cast<uint32_t>(ramp_.position()));
+  const int32_t difference = encoder_deviation();
   const int64_t magnitude = difference < 0 ? -static_cast<int64_t>(difference) : difference;
   const bool exceeded = config.max_encoder_deviation > 0 && magnitude > config.max_encoder_deviation;
   if (exceeded) {
@@ -230,8 +304,9 @@ motion::SRampConfig Tmcm142Axis::ramp_config() const {
     c.max_velocity = search_final_move_ ? config.reference_slow_pps : fastest;
   }
   c.acceleration = config.acceleration_pps2;
-  c.deceleration = switch_stopping_ ? config.stop_deceleration_pps2 : 0.0;
-  for (int i = 0; i < 4; ++i) c.bow[i] = bow_pps3(config.bow[i]);
+  c.deceleration = switch_stopping_ ? config.stop_deceleration_pps2 : config.deceleration_pps2;
+  // AP 18, the one bow of the module, limits all four changes of acceleration (Motwin decision).
+  for (double& bow : c.bow) bow = bow_pps3(config.max_bow);
   return c;
 }
 
@@ -248,8 +323,9 @@ void Tmcm142Axis::tick(board::StepperPowerStage& stage) {
   last_ramp_q32_ = ramp_q32;
 
   if (config.pid_mode == PidMode::kEasyPid) {
-    const int64_t error =
-        static_cast<int32_t>(static_cast<uint32_t>(state.encoder_position) - static_cast<uint32_t>(ramp_.position()));
+    int64_t error = encoder_deviation();
+    // AP 28: within the tolerance the loop sees no error (Motwin decision).
+    if ((error < 0 ? -error : error) <= config.pid_tolerance) error = 0;
     const auto d_ticks = static_cast<uint32_t>(std::lround(
         (config.pid.d_clock_divider == 0 ? 256 : config.pid.d_clock_divider) * kPidDClockS / kControlTickS));
     motion::EasyPid::step(config.pid, pid_, error, static_cast<int32_t>(kPidSamplesPerTick), d_ticks);
@@ -264,6 +340,7 @@ void Tmcm142Axis::tick(board::StepperPowerStage& stage) {
   }
   const uint64_t delay_ticks = static_cast<uint64_t>(config.standby_delay_10ms) * 10 * kTicksPerMillisecond;
   state.standby = standstill_ticks_ > delay_ticks;
+  state.compare_output = ramp_.position() >= config.compare_position;
 
   write_drive(stage.drive, ramp_delta_q32);
 }
@@ -275,12 +352,15 @@ void Tmcm142Axis::write_drive(board::StepperDrive& drive, int64_t ramp_delta_q32
   if (config.pid_mode == PidMode::kEasyPid) {
     delta_q32 += static_cast<int64_t>(std::llround(pid_.correction * kPpsPerVelocityUnit * kControlTickS * kQ32));
   }
+  // AP 19: the field turns the other way for the same positions.
+  if (config.shaft != 0) delta_q32 = -delta_q32;
   angle_q16_ += static_cast<uint64_t>(delta_q32 * 16384 / static_cast<int64_t>(microsteps));
   // The driver's table moves in whole microsteps of the selected resolution.
   const uint32_t per_microstep = board::kElectricalAnglePerFullStep / microsteps;
   const uint64_t exact = (angle_q16_ + 32768) >> 16;
   const auto angle = static_cast<uint32_t>((exact + per_microstep / 2) / per_microstep * per_microstep);
   const motion::CoilCurrents currents = motion::coil_currents(angle, coil_current_ma());
+  last_drive_angle_ = angle;
   drive.enabled = true;
   drive.electrical_angle = angle;
   drive.coil_a_ma = currents.coil_a_ma;
