@@ -176,6 +176,20 @@ TEST(Tmcm142RealNumbering, new_stored_settings_survive_a_power_up) {
   EXPECT_EQ(rig.command(7, 16, 0, 0).status, kWrongType) << "AP 16 is stored with AP 5";
 }
 
+TEST(Tmcm142RealNumbering, pid_tolerance_hides_a_small_error_from_the_easy_pid) {
+  Tmcm142Rig rig;
+  ASSERT_EQ(rig.sap(40, 1), kOk);   // easyPID, P = 65536 (factory)
+  ASSERT_EQ(rig.sap(41, 100), kOk);  // the encoder 100 µsteps ahead of AP 1
+  rig.tick();
+  EXPECT_EQ(rig.gap(38), 100);
+  EXPECT_EQ(rig.gap(39), -100 * 65536 / 256) << "P part: -pid_e * P / 256";
+  ASSERT_EQ(rig.sap(41, 100), kOk);
+  ASSERT_EQ(rig.sap(28, 100), kOk);
+  rig.tick();
+  EXPECT_EQ(rig.gap(38), 0) << "AP 38 shows the error the loop sees";
+  EXPECT_EQ(rig.gap(39), 0) << "within the tolerance: no correction";
+}
+
 TEST(Tmcm142RealNumbering, gp_131_keeps_the_status_of_the_last_failed_command) {
   Tmcm142Rig rig;
   EXPECT_EQ(rig.ggp(131), 0);

@@ -130,7 +130,7 @@ const Tmcm142::Table& Tmcm142::axis_parameters() {
     {{23, "chopper clock divider", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] chopper frequency divider; stored, no effect in the simulation"}, config_field<&AxisConfig::chopper_clock_divider>()},
     {{26, "driver status", 0, 7, 0, access("R"), Unit::kNone, "[Motwin decision] bit 0 standby current applied, bit 1 supply below 15 V, bit 2 compare output (AP 48) high"}, axis_value<&Tmcm142Axis::driver_status>()},
     {{27, "microstep resolution", kFinestResolutionCode, kCoarsestResolutionCode, kFinestResolutionCode, access("RWE"), Unit::kNone, "2^(11 - value) microsteps per full step: 1 = 1024 ... 11 = full steps; 0 (2048) refused"}, config_field<&AxisConfig::microstep_code>()},
-    {{28, "PID tolerance", 0, 1 << 23, 0, access("RWE"), Unit::kMicrosteps, "[Motwin decision] |pid_e| up to this counts as 0 for the easyPID"}, config_field<&AxisConfig::pid_tolerance>()},
+    {{28, "PID tolerance", 0, 1 << 23, 0, access("RWE"), Unit::kMicrosteps, "[Motwin decision] |encoder - actual position| up to this counts as 0 for the easyPID (AP 38 then reads 0)"}, config_field<&AxisConfig::pid_tolerance>()},
     {{29, "sine wave offset", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] offset of the driver's sine table; stored, no effect in the simulation"}, config_field<&AxisConfig::sine_wave_offset>()},
     {{30, "PID p factor", 0, 16777215, 65536, access("RWE"), Unit::kNone, "[Motwin decision] range and default; easyPID P: -pid_e * P / 256"}, pid_field<&motion::EasyPidConfig::p>()},
     {{31, "PID i factor", 0, 16777215, 0, access("RWE"), Unit::kNone, "[Motwin decision] range; easyPID I: -pid_isum * I / 65536"}, pid_field<&motion::EasyPidConfig::i>()},
