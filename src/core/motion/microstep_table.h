@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "board/stepper_drive.h"
@@ -39,8 +40,9 @@ constexpr std::array<uint16_t, kMicrostepTableQuarter + 1> make_quarter_sine() {
 
 }  // namespace detail
 
-// sin of (i / 1024) x 90°, scaled by 2^15, i = 0..1024.
-inline constexpr std::array<uint16_t, kMicrostepTableQuarter + 1> kQuarterSine = detail::make_quarter_sine();
+// sin of (i / 1024) x 90°, scaled by 2^15, i = 0..1024. Defined once (microstep_table.cpp): as an
+// inline variable every file that reads it kept a 2 KiB copy in the core's archive.
+extern const std::array<uint16_t, kMicrostepTableQuarter + 1> kQuarterSine;
 
 // Coil current targets (mA, signed) for an electrical angle (2^32 per electrical revolution,
 // board/stepper_drive.h) at amplitude current_ma: coil A the cosine, coil B the sine.
