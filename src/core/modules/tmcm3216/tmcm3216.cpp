@@ -537,3 +537,5 @@ void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {
 }
 
 }  // namespace motwin::modules::tmcm3216
+
+template class motwin::canopen::TableDictionary<motwin::modules::tmcm3216::Tmcm3216>;

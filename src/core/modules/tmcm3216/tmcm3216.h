@@ -269,3 +269,7 @@ class Tmcm3216 final : private canopen::LssDevice {
 };
 
 }  // namespace motwin::modules::tmcm3216
+
+// Instantiated once, in tmcm3216.cpp: the object rows' mapping checks look objects up too, and a
+// second copy of the lookup would cost the core's text.
+extern template class motwin::canopen::TableDictionary<motwin::modules::tmcm3216::Tmcm3216>;
