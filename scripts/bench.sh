@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The performance report: builds Motwin in Release (build-release/), runs every benchmark in
 # bench/ (bench/*.cpp, so benchmarks added later are picked up), measures the core's code size
-# with -Os -fno-exceptions -fno-rtti (build-minsize/), and writes a markdown report to stdout and
+# with -Os -fno-exceptions -fno-rtti (build-minsize/) and what its bytes are (scripts/core_size.py),
+# and writes a markdown report to stdout and
 # build-release/report.md. docs/PERFORMANCE.md explains how to read it.
 #
 #   scripts/bench.sh                 # the report (a few minutes)
@@ -67,6 +68,8 @@ for bench in "${benches[@]}"; do
 done
 
 size -t "$minsize/libmotwin_core.a" >"$logs/core_size.txt"
+/usr/bin/python3 scripts/core_size.py "$minsize" --symbols 15 >"$logs/core_breakdown.txt" ||
+  echo "(scripts/core_size.py failed)" >"$logs/core_breakdown.txt"
 
 /usr/bin/python3 - "$logs" "$build/report.md" "${benches[@]}" <<'PYTHON'
 import datetime
@@ -179,8 +182,11 @@ for m in re.finditer(r"^\s+(\S+)\s+([\d.]+) ms wall\s+([\d.]+)x real time\s+(?:(
 sizes = text("core_size")
 total = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+\S+\s+\(TOTALS\)", sizes, re.M)
 if total:
-    rows.append(("core code size (-Os -fno-exceptions -fno-rtti, libmotwin_core.a)", f"{int(total.group(1))} B text",
-                 f"{total.group(2)} B data, {total.group(3)} B bss", ""))
+    text_bytes = int(total.group(1))
+    rows.append(("core code size (-Os -fno-exceptions -fno-rtti, no unwind tables, libmotwin_core.a)",
+                 f"{text_bytes} B text ({text_bytes / 1024:.1f} KiB)",
+                 f"{total.group(2)} B data, {total.group(3)} B bss",
+                 f"goal at most 128 KiB of text: {'met' if text_bytes <= 128 * 1024 else 'NOT met'}"))
 
 footprint = text("bench_module_footprint")
 
@@ -197,6 +203,7 @@ report = [f"# Motwin performance report", "",
 report += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
 report += ["", "## Memory per module instance and whole-module simulation speed", "",
            footprint.strip() or "(bench_module_footprint missing)", ""]
+report += ["## What the core's text is", "", text("core_breakdown").strip() or "(scripts/core_size.py missing)", ""]
 report += ["## Each benchmark's own summary", ""]
 for name in benches:
     if name == "bench_module_footprint":
