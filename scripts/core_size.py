@@ -4,6 +4,8 @@ code, constant data and the unwind tables) per module and per service, from binu
 
   scripts/core_size.py build-minsize            # markdown tables on stdout
   scripts/core_size.py build-minsize --symbols 30   # and the 30 biggest symbols
+  scripts/core_size.py build-minsize --image build-minsize/core_all_modules.map
+      # and what of it a firmware image of the three modules keeps (the core_all_modules target)
 
 scripts/bench.sh runs it on its -Os build (build-minsize/), so the performance report carries the
 tables; docs/PERFORMANCE.md "How to read it" explains them. Every byte lands in exactly one row, so
@@ -162,6 +164,67 @@ class ObjectFile:
             yield None, "unwind", size - attributed
 
 
+def image_pieces(map_path):
+    """(path under src/core/ without .o, section name, kind, bytes) of each input section of the
+    core that a --gc-sections link kept, from the linker's map file (core_all_modules.map)."""
+    pieces = []
+    with open(map_path) as f:
+        lines = f.read().split("Linker script and memory map", 1)[-1].splitlines()
+    pending = None
+    for line in lines:
+        one = re.match(r"^ (\.\S+)\s+0x[0-9a-f]+\s+0x([0-9a-f]+)\s+(\S+\.o)$", line)
+        if one:
+            found = (one.group(1), int(one.group(2), 16), one.group(3))
+        elif pending:
+            two = re.match(r"^\s+0x[0-9a-f]+\s+0x([0-9a-f]+)\s+(\S+\.o)$", line)
+            found = (pending, int(two.group(1), 16), two.group(2)) if two else None
+        else:
+            found = None
+        head = re.match(r"^ (\.\S+)$", line)
+        pending = head.group(1) if head else None
+        if not found or "/src/core/" not in found[2] or found[1] == 0:
+            continue
+        name, size, obj = found
+        rel = obj.split("/src/core/", 1)[1][: -len(".o")]
+        if name.startswith(".text"):
+            kind = "code"
+        elif name.startswith(".rodata"):
+            kind = "constants"
+        elif name.startswith(".eh_frame"):
+            kind = "unwind"
+        elif name.startswith(".bss") or name.startswith(".tbss"):
+            kind = "bss"
+        else:
+            kind = "data"
+        pieces.append((rel, name, kind, size))
+    return pieces
+
+
+def print_image(map_path):
+    pieces = image_pieces(map_path)
+    if not pieces:
+        print(f"(no input section of the core in {map_path})")
+        return
+    per_module = collections.defaultdict(collections.Counter)
+    for rel, _, kind, size in pieces:
+        per_module[module_of(rel)][kind] += size
+    total = collections.Counter()
+    print("The core in a firmware image of all three modules (bench/size/core_all_modules.cpp: a section per "
+          "function and table, linked with --gc-sections): what the modules reach, each template and table "
+          "once.")
+    print()
+    print("| module | text | code | constants | data | bss |")
+    print("|---|---|---|---|---|---|")
+    for module in MODULES + ("shared",):
+        c = per_module[module]
+        total.update(c)
+        print(f"| {module} | {c['code'] + c['constants'] + c['unwind']} | {c['code']} | {c['constants']} "
+              f"| {c['data']} | {c['bss']} |")
+    text_bytes = total["code"] + total["constants"] + total["unwind"]
+    print(f"| **total** | **{text_bytes}** ({text_bytes / 1024:.1f} KiB) | {total['code']} | {total['constants']} "
+          f"| {total['data']} | {total['bss']} |")
+
+
 def module_of(rel):
     m = re.match(r"modules/(\w+)/", rel)
     return m.group(1) if m and m.group(1) in MODULES else "shared"
@@ -184,6 +247,7 @@ def main():
         sys.exit(__doc__)
     build = args[0]
     top = int(args[args.index("--symbols") + 1]) if "--symbols" in args else 0
+    image_map = args[args.index("--image") + 1] if "--image" in args else None
     root = os.path.join(build, "CMakeFiles", "motwin_core.dir", "src", "core")
     objects = []
     for directory, _, files in os.walk(root):
@@ -247,6 +311,9 @@ def main():
         for size, kind, name in sorted(ranked, reverse=True)[:top]:
             shown = name if len(name) <= 110 else name[:107] + "..."
             print(f"| {size} | {kind} | `{shown.replace('|', '/')}` |")
+    if image_map:
+        print()
+        print_image(image_map)
 
 
 if __name__ == "__main__":
