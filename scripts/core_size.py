@@ -6,6 +6,8 @@ code, constant data and the unwind tables) per module and per service, from binu
   scripts/core_size.py build-minsize --symbols 30   # and the 30 biggest symbols
   scripts/core_size.py build-minsize --image build-minsize/core_all_modules.map
       # and what of it a firmware image of the three modules keeps (the core_all_modules target)
+  scripts/core_size.py build --check build/libmotwin_core.a
+      # the tables account for every byte: their sums equal `size -t` of the archive (CTest)
 
 scripts/bench.sh runs it on its -Os build (build-minsize/), so the performance report carries the
 tables; docs/PERFORMANCE.md "How to read it" explains them. Every byte lands in exactly one row, so
@@ -248,6 +250,7 @@ def main():
     build = args[0]
     top = int(args[args.index("--symbols") + 1]) if "--symbols" in args else 0
     image_map = args[args.index("--image") + 1] if "--image" in args else None
+    check_archive = args[args.index("--check") + 1] if "--check" in args else None
     root = os.path.join(build, "CMakeFiles", "motwin_core.dir", "src", "core")
     objects = []
     for directory, _, files in os.walk(root):
@@ -277,6 +280,22 @@ def main():
 
     def text(counter):
         return sum(counter[k] for k in KINDS)
+
+    if check_archive:
+        # Every byte in exactly one row: the tables' totals are the archive's `size -t` totals.
+        totals = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+\S+\s+\(TOTALS\)",
+                           run("size", "-t", check_archive), re.M)
+        archive = tuple(int(g) for g in totals.groups())
+        summed = collections.Counter()
+        for c in modules.values():
+            summed.update(c)
+        by_module = (text(summed), summed["data"], summed["bss"])
+        by_service = sum(text(c) for c in services.values())
+        if by_module != archive or by_service != archive[0]:
+            sys.exit(f"core_size: text, data, bss per module {by_module}, text per service {by_service}; "
+                     f"size -t of {check_archive}: {archive}")
+        print(f"core_size: per module and per service sums equal size -t of {check_archive}: {archive}")
+        return
 
     print("Text of the core per module: code, constants (tables, strings) and unwind tables (.eh_frame), "
           "as `size` counts them; `shared` is the protocol, profile and motion code every module links.")
