@@ -9,6 +9,7 @@
 //   endpoint can-slcan-tcp 127.0.0.1:<port>       one per --can slcan-tcp:...
 //   endpoint can-slcan-pty <LINK> </dev/pts/N>     one per --can slcan:LINK
 //   endpoint can-socketcan <IFACE>                 one per --can socketcan:IFACE
+//   endpoint can-socketcand-client <HOST:PORT> <CHANNEL>  one per --can socketcand-client:...
 // With --node (several modules on one bus) the first line is one line per node instead:
 //   motwin: node <name> <module> (<firmware>) eeprom <path|none>
 //   ready
@@ -43,6 +44,7 @@
 #include "host/persist_crash_hook.h"
 #include "host/pty_endpoint.h"
 #include "host/slcan_server.h"
+#include "host/socketcand_client.h"
 #include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
@@ -411,6 +413,7 @@ std::string where(const host::TmclTcpServer& server) { return server.local_addre
 std::string where(const host::SocketcandServer& server) { return server.local_address(); }
 std::string where(const host::SlcanTcpServer& server) { return server.local_address(); }
 std::string where(const host::SocketcanEndpoint& can) { return can.interface_name(); }
+std::string where(const host::SocketcandClientEndpoint& client) { return client.where(); }
 std::string where(const host::TmclPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
 std::string where(const host::SlcanPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
 
@@ -432,6 +435,9 @@ Result<OpenEndpoint> open_can_endpoint(host::EventLoop& loop, host::CanBus& bus,
       return keep_open(host::SocketcanEndpoint::open(loop, bus, spec.device), "can-socketcan", "--can: ");
     case host::CanTransport::kSlcanTcp:
       return keep_open(host::SlcanTcpServer::open(loop, bus, spec.tcp), "can-slcan-tcp", "--can: ");
+    case host::CanTransport::kSocketcandClient:
+      return keep_open(host::SocketcandClientEndpoint::open(loop, bus, {spec.tcp, spec.device}), "can-socketcand-client",
+                       "--can: ");
     case host::CanTransport::kSocketcand:
       break;
   }
@@ -701,15 +707,17 @@ void add_serve_command(CLI::App& app, int& exit_status) {
                     "Put the module on a virtual CAN bus served as socketcand[:HOST]:PORT (python-can's "
                     "interface='socketcand'), slcan-tcp:[HOST:]PORT (interface='slcan', "
                     "channel='socket://HOST:PORT'), slcan:LINK (an SLCAN adapter on a pseudo-terminal, LINK a "
-                    "symbolic link to it) or socketcan:IFACE (a Linux CAN interface such as vcan0); port 0 picks a "
-                    "free port. Repeatable: all share one bus. Modules that start on the bus (" +
+                    "symbolic link to it), socketcan:IFACE (a Linux CAN interface such as vcan0) or "
+                    "socketcand-client:HOST:PORT:CHANNEL (join the bus of a socketcand server elsewhere: a socketcand "
+                    "daemon on a gateway, another motwin serve); port 0 picks a free port. Repeatable: all share one "
+                    "bus. Modules that start on the bus (" +
                         host::module_names([](const host::ModuleDescriptor& module) {
                           return module.endpoints.default_endpoint == host::DefaultEndpoint::kCanSocketcand;
                         }) +
                         ") default to socketcand:127.0.0.1:29536; TMCL modules (" +
                         host::module_names([](const host::ModuleDescriptor& module) { return module.endpoints.tmcl_can; }) +
                         ") answer TMCL on GP 71/70. See docs/canopen.md")
-      ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT|slcan:LINK|socketcan:IFACE")
+      ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT|slcan:LINK|socketcan:IFACE|socketcand-client:HOST:PORT:CHANNEL")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   serve->add_option("--can-capture", arguments->can_capture,

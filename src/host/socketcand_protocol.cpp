@@ -86,6 +86,43 @@ Result<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>&
   return frame;
 }
 
+Result<can::CanFrame> parse_socketcand_frame(const std::vector<std::string_view>& words) {
+  if (words.size() < 3 || words.size() > 4 || words[0] != "frame") return Error{"frame needs an ID and a time"};
+  can::CanFrame frame;
+  uint32_t id = 0;
+  if (!parse_hex(words[1], id) || id > can::kMaxExtendedId) return Error{"bad CAN ID"};
+  frame.id = id;
+  frame.extended = words[1].size() == 8 || id > can::kMaxStandardId;
+  const std::string_view time = words[2];
+  const size_t dot = time.find('.');
+  const auto all_digits = [](std::string_view text) {
+    return !text.empty() && text.find_first_not_of("0123456789") == std::string_view::npos;
+  };
+  if (dot == std::string_view::npos || !all_digits(time.substr(0, dot)) || !all_digits(time.substr(dot + 1))) {
+    return Error{"bad time"};
+  }
+  const std::string_view data = words.size() == 4 ? words[3] : std::string_view{};
+  if (data.size() % 2 != 0 || data.size() > 2 * can::kMaxDataLength) return Error{"bad data"};
+  frame.dlc = static_cast<uint8_t>(data.size() / 2);
+  for (uint8_t i = 0; i < frame.dlc; ++i) {
+    uint32_t byte = 0;
+    if (!parse_hex(data.substr(2 * i, 2), byte)) return Error{"bad data"};
+    frame.data[i] = static_cast<uint8_t>(byte);
+  }
+  return frame;
+}
+
+std::string format_socketcand_send(const can::CanFrame& frame) {
+  const uint8_t length = frame.dlc > can::kMaxDataLength ? can::kMaxDataLength : frame.dlc;
+  char text[80];
+  int used = std::snprintf(text, sizeof(text), frame.extended ? "< send %08X %u" : "< send %03X %u",
+                           static_cast<unsigned>(frame.id), static_cast<unsigned>(length));
+  for (uint8_t i = 0; i < length; ++i) {
+    used += std::snprintf(text + used, sizeof(text) - static_cast<size_t>(used), " %02X", frame.data[i]);
+  }
+  return std::string(text, static_cast<size_t>(used)) + " >";
+}
+
 std::string format_socketcand_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
   char head[64];
   std::snprintf(head, sizeof(head), frame.extended ? " < frame %08X %llu.%06llu " : " < frame %03X %llu.%06llu ",

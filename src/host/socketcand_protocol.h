@@ -50,4 +50,15 @@ Result<can::CanFrame> parse_socketcand_send(const std::vector<std::string_view>&
 // opening < found" for every read (docs/canopen.md).
 std::string format_socketcand_frame(const can::CanFrame& frame, uint64_t timestamp_us);
 
+// The client's side (host/socketcand_client.h), with the same element parser and words:
+// `frame ID SEC.USEC [HEXDATA]` words (with "frame" first) into a frame, as socketcand and
+// format_socketcand_frame() write it: ID as for `send`, the data one hex string of up to 16 digits
+// (even count), absent for an empty frame. The timestamp is checked for its form only (the
+// receiving bus stamps the frame with its own clock).
+Result<can::CanFrame> parse_socketcand_frame(const std::vector<std::string_view>& words);
+
+// `< send ID LEN B0 B1 ... >`, as python-can writes it: ID %03X or %08X (extended), the bytes %02X.
+// Data frames only: socketcand's `send` has no RTR flag (the client does not forward RTR frames).
+std::string format_socketcand_send(const can::CanFrame& frame);
+
 }  // namespace motwin::host

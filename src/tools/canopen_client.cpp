@@ -45,19 +45,9 @@ uint64_t parse_timestamp_us(std::string_view text) {
 
 std::optional<ReceivedFrame> parse_frame_element(const std::string& element) {
   const std::vector<std::string_view> words = host::socketcand_words(element);
-  if (words.size() < 3 || words[0] != "frame") return std::nullopt;
-  can::CanFrame frame;
-  frame.id = static_cast<uint32_t>(std::strtoul(std::string(words[1]).c_str(), nullptr, 16));
-  frame.extended = words[1].size() == 8;
-  if (words.size() >= 4) {
-    const std::string_view hex = words[3];
-    if (hex.size() % 2 != 0 || hex.size() > 16) return std::nullopt;
-    frame.dlc = static_cast<uint8_t>(hex.size() / 2);
-    for (uint8_t i = 0; i < frame.dlc; ++i) {
-      frame.data[i] = static_cast<uint8_t>(std::strtoul(std::string(hex.substr(i * 2u, 2)).c_str(), nullptr, 16));
-    }
-  }
-  return ReceivedFrame{frame, parse_timestamp_us(words[2])};
+  const Result<can::CanFrame> frame = host::parse_socketcand_frame(words);
+  if (!frame) return std::nullopt;
+  return ReceivedFrame{*frame, parse_timestamp_us(words[2])};
 }
 
 }  // namespace
@@ -109,16 +99,7 @@ Result<std::unique_ptr<SocketcandClient>> SocketcandClient::connect(const std::s
 SocketcandClient::~SocketcandClient() { ::close(fd_); }
 
 Result<void> SocketcandClient::send(const can::CanFrame& frame) {
-  char head[40];
-  std::snprintf(head, sizeof(head), frame.extended ? "< send %08X %u" : "< send %03X %u", static_cast<unsigned>(frame.id),
-                static_cast<unsigned>(frame.dlc));
-  std::string text = head;
-  for (uint8_t i = 0; i < frame.dlc && i < 8; ++i) {
-    char byte[4];
-    std::snprintf(byte, sizeof(byte), " %02X", frame.data[i]);
-    text += byte;
-  }
-  text += " >";
+  const std::string text = host::format_socketcand_send(frame);
   if (::send(fd_, text.data(), text.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(text.size())) {
     return Error{"cannot send to the socketcand server"};
   }
