@@ -219,6 +219,7 @@ void PtyPort::read_some() {
     // A status packet carries no data. A client that flushed its input (pyserial on open) wants
     // nothing old: drop our output, including the tail of what the pty took only in part.
     if ((status & TIOCPKT_FLUSHREAD) != 0) {
+      discard_written_output();
       output_.clear();
       reported_dropped_output_ = false;
     }
@@ -228,6 +229,19 @@ void PtyPort::read_some() {
   }
   handlers_.on_data(buffer + 1, static_cast<size_t>(n - 1));
   update_events();
+}
+
+void PtyPort::discard_written_output() {
+  // The kernel empties the client's input queue and wakes us as a writer before we read the
+  // flush status: output written in between landed in the flushed queue (seen on a loaded
+  // machine: a pty full of old frames, the last one cut short, so that the client's first
+  // answer after the flush ran into it and was lost). It is old too: flush it again from our
+  // side, with packet mode off so that this flush is not reported back to us as the client's.
+  int off = 0;
+  int on = 1;
+  ::ioctl(master_fd_, TIOCPKT, &off);
+  ::tcflush(slave_fd_, TCIFLUSH);
+  ::ioctl(master_fd_, TIOCPKT, &on);
 }
 
 bool PtyPort::write(const uint8_t* bytes, size_t length) {

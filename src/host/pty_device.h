@@ -72,6 +72,8 @@ class PtyPort {
   void on_events(short revents);
   void read_some();
   void flush();
+  // After a client's input flush: what we wrote since it began is old too (pty_device.cpp).
+  void discard_written_output();
 
   EventLoop& loop_;
   int master_fd_;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "host/can_bus.h"
+#include "host/can_endpoint.h"
 #include "host/event_loop.h"
 #include "host/socketcand_client.h"
 #include "host/socketcand_protocol.h"
@@ -237,6 +238,33 @@ TEST(SocketcandClientEndpoint, reconnects_when_the_server_comes_back) {
   buses.local.send(buses.local_id, frame_on(0x182, {2}));
   ASSERT_TRUE(buses.pump_until([&] { return !buses.remote_node.frames.empty(); }));
   EXPECT_EQ(buses.remote_node.frames, (std::vector<can::CanFrame>{frame_on(0x182, {2})}));
+}
+
+}  // namespace
+}  // namespace motwin::host
+
+namespace motwin::host {
+namespace {
+
+TEST(CanEndpointSpec, socketcand_client_takes_host_port_and_channel) {
+  Result<CanEndpointSpec> spec = parse_can_endpoint("socketcand-client:gateway.local:29536:can1");
+  ASSERT_TRUE(spec) << spec.error();
+  EXPECT_EQ(spec->transport, CanTransport::kSocketcandClient);
+  EXPECT_EQ(spec->tcp.host, "gateway.local");
+  EXPECT_EQ(spec->tcp.port, 29536);
+  EXPECT_EQ(spec->device, "can1");
+  spec = parse_can_endpoint("socketcand-client:[::1]:4000:vcan0");
+  ASSERT_TRUE(spec) << spec.error();
+  EXPECT_EQ(spec->tcp.host, "::1");
+  EXPECT_EQ(spec->tcp.port, 4000);
+  EXPECT_EQ(spec->device, "vcan0");
+  for (const char* bad : {"socketcand-client", "socketcand-client:127.0.0.1:29536", "socketcand-client:29536:can0",
+                          "socketcand-client:127.0.0.1:0:can0", "socketcand-client:127.0.0.1:29536:",
+                          "socketcand-client:127.0.0.1:x:can0", "socketcand-client:127.0.0.1:1:c<0"}) {
+    const Result<CanEndpointSpec> refused = parse_can_endpoint(bad);
+    ASSERT_FALSE(refused) << bad;
+    EXPECT_NE(refused.error().find("socketcand-client needs HOST:PORT:CHANNEL"), std::string::npos) << bad;
+  }
 }
 
 }  // namespace
