@@ -24,11 +24,15 @@ VENDOR, PRODUCT, REVISION = 0x286, 3216, 0x00010004
 # so a late answer on a loaded machine would mislead the scan; the default is 0.05 s).
 ANSWER_TIMEOUT = "10"
 FASTSCAN_STEP_TIMEOUT = "0.5"
+# How long one `motwin lss` may run at all: a liveness bound, not a speed check. A fastscan is 128
+# probes, each a round trip plus a settle time and, for every 1 bit of the identity, a silent step
+# timeout; under ASan on a loaded machine that took more than the 30 s this once was.
+COMMAND_TIMEOUT = 300
 
 
 def lss(motwin, server, *args):
     result = subprocess.run([motwin, "lss", "--can", f"socketcand:127.0.0.1:{server.port()}", *args],
-                            capture_output=True, timeout=30)
+                            capture_output=True, timeout=COMMAND_TIMEOUT)
     return result.returncode, result.stdout.decode().strip(), result.stderr.decode().strip()
 
 
