@@ -221,8 +221,12 @@ def test_slcan_pty_flood(motwin):
                     writer.join(30.0)
                     check(not writer.is_alive() and writer.failure is None, f"never-reading writer: {writer.failure}")
                     memory.check("SLCAN pty flood, client not reading")
+                    # One line per episode, never one per frame. Two episodes can happen: frames may
+                    # already pile up between the windowed client's close and this open (the adapter's
+                    # channel stays open), and the flush on open ends that episode.
                     dropped = [line for line in server.stderr_lines() if f"nobody reads {link}" in line]
-                    check_equal(len(dropped), 1, f"log lines about dropped output ({server.stderr_lines()[-5:]})")
+                    check(1 <= len(dropped) <= 2, f"log lines about dropped output: {len(dropped)} "
+                          f"({server.stderr_lines()[-5:]})")
                     sleepy.flush_input()  # what pyserial does on open
                     sleepy.send("V\r")
                     check_equal(first_answer_after_open(sleepy, after_transmits=True, server=server), "V1013\r", "first answer after the flush")
