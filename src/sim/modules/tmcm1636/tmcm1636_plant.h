@@ -4,11 +4,18 @@
 // capacitance, brake-chopper resistor), current sensing through the ADC with seeded noise, hall
 // sensors, an ABN encoder with index, an absolute encoder and the driver's thermal model.
 //
-// Integrated in double precision: the currents in 3 sub-steps per control tick
-// (kDefaultSubSteps) by the exact exponential update of the RL circuits (stable at any step), with
-// the rotor turning at the tick's initial speed; the mechanics and the supply bus (whose time
-// constants are far longer than a sub-step, or solved exactly) once per tick. The PWM computed in a tick is applied from
-// the next tick on (one-tick delay). Equations and defaults: docs/tmcm-1636-servo.md.
+// Integrated in double precision. The currents take one exact step per control tick: with the
+// bridge voltage held over the tick (zero-order hold of the latched duties in the stationary frame)
+// and the rotor turning at the tick's initial speed, the RL circuits with back-EMF and
+// cross-coupling are linear with constant coefficients, and their solution at the tick's end and
+// its mean over the tick are closed forms (exponential decay and a rotation, constants computed
+// when the tick length is first seen). A salient motor (Ld != Lq) and the reference stepping
+// (sub_steps >= 1) take sub-steps of the exact exponential update with the back-EMF and
+// cross-coupling held per sub-step, as before. The mechanics and the supply bus (whose time
+// constants are far longer than a tick, or solved exactly) advance once per tick with the
+// tick's mean torque and bus current. The PWM computed in a tick is applied from the next tick on
+// (one-tick delay). Equations, defaults and the error against sub-stepping:
+// docs/tmcm-1636-servo.md.
 #pragma once
 
 #include <cstdint>
@@ -57,7 +64,12 @@ struct Tmcm1636BoardModel {
 
 class Tmcm1636Plant {
  public:
-  static constexpr int kDefaultSubSteps = 3;
+  // sub_steps: kExactStep (0) steps the currents exactly once per tick (the default; a salient
+  // motor takes kReferenceSubSteps); n >= 1 takes n sub-steps of the earlier integrator, kept as
+  // the reference the exact step is tested against.
+  static constexpr int kExactStep = 0;
+  static constexpr int kReferenceSubSteps = 3;
+  static constexpr int kDefaultSubSteps = kExactStep;
 
   explicit Tmcm1636Plant(const MotorDescription& motor, uint64_t noise_seed = 0x1636,
                          const Tmcm1636BoardModel& board = Tmcm1636BoardModel{}, int sub_steps = kDefaultSubSteps);
@@ -114,6 +126,7 @@ class Tmcm1636Plant {
  private:
   static void rotation(double delta, double& c, double& s);
   double electrical_substep(double rotate_cos, double rotate_sin);
+  double electrical_exact_step(double rotate_cos, double rotate_sin, double turned_rad);
   void mechanics(double dt_s, double torque);
   void update_bus(double dt_s);
   int32_t abn_count_at(double theta) const;
@@ -123,7 +136,8 @@ class Tmcm1636Plant {
   MotorDescription motor_;
   Tmcm1636BoardModel board_;
   NoiseSource noise_;
-  int sub_steps_;
+  int sub_steps_;      // of the reference integrator
+  bool exact_step_;    // one exact step per tick (non-salient BLDC, DC)
   board::Tmcm1636Drive latched_{};
   // State.
   double theta_ = 0.0;  // mechanical angle, rad, continuous
@@ -157,6 +171,12 @@ class Tmcm1636Plant {
   double decay_q_ = 0.0;
   double bus_decay_[4] = {};  // per tick, [source conducting][chopper on]
   double bus_current_sum_ = 0.0;
+  // The exact step: decay over the tick exp(-R dt / L), its mean over the tick (1 - decay) L /
+  // (R dt), and R / L.
+  double tick_decay_ = 0.0;
+  double tick_mean_decay_ = 0.0;
+  double rate_ = 0.0;
+  double tick_rate_dt_ = 0.0;  // R dt / L
   // The latched duties as the stationary voltage vector per volt of bus (alpha, beta), and the
   // DC motor's U-V duty difference: set once per tick.
   double duty_alpha_ = 0.0;
