@@ -22,6 +22,32 @@ double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 // Rounds half away from zero, as lround does, without the library call.
 int32_t round_to_int(double v) { return static_cast<int32_t>(v >= 0.0 ? v + 0.5 : v - 0.5); }
 
+// cos and sin of a small angle: Taylor terms to the 7th order are exact to 3e-13 below 0.1 rad
+// (to the 5th order, as before, they were off by up to 1.4e-9); larger angles take the library.
+inline void rotation(double delta, double& c, double& s) {
+  if (std::fabs(delta) < 0.1) {
+    const double d2 = delta * delta;
+    c = 1.0 - d2 * (0.5 - d2 * ((1.0 / 24.0) - d2 * (1.0 / 720.0)));
+    s = delta * (1.0 - d2 * ((1.0 / 6.0) - d2 * ((1.0 / 120.0) - d2 * (1.0 / 5040.0))));
+  } else {
+    c = std::cos(delta);
+    s = std::sin(delta);
+  }
+}
+
+// g(phi) = (exp(j phi) - 1) / (j phi): the mean of exp(j phi t / dt) over the tick, given cos and
+// sin of phi; the series below 0.1 rad (the quotients lose digits there) is exact to 3e-14.
+void rotation_mean(double phi, double cos_phi, double sin_phi, double& real, double& imaginary) {
+  if (std::fabs(phi) < 0.1) {
+    const double p2 = phi * phi;
+    real = 1.0 - p2 * ((1.0 / 6.0) - p2 * ((1.0 / 120.0) - p2 * (1.0 / 5040.0)));
+    imaginary = phi * (0.5 - p2 * ((1.0 / 24.0) - p2 * ((1.0 / 720.0) - p2 * (1.0 / 40320.0))));
+  } else {
+    real = sin_phi / phi;
+    imaginary = (1.0 - cos_phi) / phi;
+  }
+}
+
 }  // namespace
 
 Tmcm1636Plant::Tmcm1636Plant(const MotorDescription& motor, uint64_t noise_seed, const Tmcm1636BoardModel& board,
@@ -248,35 +274,6 @@ void Tmcm1636Plant::advance(const board::Tmcm1636Drive& drive, double dt_s) {
 }
 
 
-// cos and sin of a small angle: Taylor terms to the 5th order are exact to double precision
-// below 0.1 rad; larger angles take the library call.
-void Tmcm1636Plant::rotation(double delta, double& c, double& s) {
-  if (std::fabs(delta) < 0.1) {
-    const double d2 = delta * delta;
-    c = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
-    s = delta * (1.0 - d2 * ((1.0 / 6.0) - d2 * (1.0 / 120.0)));
-  } else {
-    c = std::cos(delta);
-    s = std::sin(delta);
-  }
-}
-
-namespace {
-
-// g(phi) = (exp(j phi) - 1) / (j phi): the mean of exp(j phi t / dt) over the tick, given cos and
-// sin of phi; the series below 0.1 rad (the quotients lose digits there) is exact to 3e-14.
-void rotation_mean(double phi, double cos_phi, double sin_phi, double& real, double& imaginary) {
-  if (std::fabs(phi) < 0.1) {
-    const double p2 = phi * phi;
-    real = 1.0 - p2 * ((1.0 / 6.0) - p2 * ((1.0 / 120.0) - p2 * (1.0 / 5040.0)));
-    imaginary = phi * (0.5 - p2 * ((1.0 / 24.0) - p2 * ((1.0 / 720.0) - p2 * (1.0 / 40320.0))));
-  } else {
-    real = sin_phi / phi;
-    imaginary = (1.0 - cos_phi) / phi;
-  }
-}
-
-}  // namespace
 
 // The currents over one whole tick, exactly, for the voltage held in the stationary frame and the
 // rotor turning at the tick's initial speed by phi (cos, sin: rotate_cos, rotate_sin). With

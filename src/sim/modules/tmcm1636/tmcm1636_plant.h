@@ -124,7 +124,6 @@ class Tmcm1636Plant {
   double absolute_reading_at_electrical_zero() const;
 
  private:
-  static void rotation(double delta, double& c, double& s);
   double electrical_substep(double rotate_cos, double rotate_sin);
   double electrical_exact_step(double rotate_cos, double rotate_sin, double turned_rad);
   void mechanics(double dt_s, double torque);
