@@ -63,7 +63,7 @@ void check_motor(const Result<sim::StepperMotorDescription>& loaded) {
                  m.full_steps_per_revolution % 4 == 0,
              "full steps per revolution %d", m.full_steps_per_revolution);
   // The parser refuses motors whose explicit rotor integration would diverge.
-  const double sub_step_s = modules::tmcm142::kControlTickS / sim::StepperPlant::kDefaultSubSteps;
+  const double sub_step_s = modules::tmcm142::kControlTickS / sim::StepperPlant::kFinestSubSteps;
   FUZZ_CHECK(sim::StepperPlant::step_number(m, sub_step_s) <= sim::StepperPlant::kStableStepNumber,
              "a loaded motor the plant cannot integrate stably: step number %g",
              sim::StepperPlant::step_number(m, sub_step_s));

@@ -14,8 +14,6 @@ constexpr double kCurrentPresentA = 1e-3;
 constexpr double kPauseS = 0.02;
 constexpr double kElectricalCircle = 4294967296.0;  // 2^32 per electrical revolution
 
-double wrap_angle(double rad) { return rad - kTwoPi * std::nearbyint(rad / kTwoPi); }
-
 uint16_t mean_of(const std::array<uint16_t, 4>& values, int count) {
   uint32_t sum = 0;
   for (int i = 0; i < count; ++i) sum += values[static_cast<size_t>(i)];
@@ -41,13 +39,26 @@ void StallGuardModel::reset() {
 
 void StallGuardModel::update(const StepperPlant& plant, const board::StepperDrive& drive,
                              const StallGuardSettings& settings, double dt_s) {
-  const double ia = plant.coil_a_current_a();
-  const double ib = plant.coil_b_current_a();
-  const bool present = std::hypot(ia, ib) > kCurrentPresentA;
-  // The coil-current vector's electrical angle: coil A carries the cosine, B the sine.
-  const double current_angle = present ? std::atan2(ib, ia) : 0.0;
-  const double rotor = plant.electrical_angle_rad();
-  update_with_angles(drive, current_angle - rotor, rotor, present, settings, dt_s);
+  double ia = plant.coil_a_current_a();
+  double ib = plant.coil_b_current_a();
+  const double magnitude_squared = ia * ia + ib * ib;
+  const bool present = magnitude_squared > kCurrentPresentA * kCurrentPresentA;
+  // The load angle δ = (the coil-current vector's angle, A the cosine, B the sine) - rotor, as
+  // sin δ and cos δ from the plant's sin and cos of the rotor angle (no atan2 and sin per tick);
+  // without current the vector's angle counts as 0.
+  if (present) {
+    const double inverse_magnitude = 1.0 / std::sqrt(magnitude_squared);
+    ia *= inverse_magnitude;
+    ib *= inverse_magnitude;
+  } else {
+    ia = 1.0;
+    ib = 0.0;
+  }
+  const double s = plant.electrical_sin();
+  const double c = plant.electrical_cos();
+  const double sin_delta = ib * c - ia * s;
+  const double cos_delta = ia * c + ib * s;
+  update_with_load(drive, load_term(sin_delta, cos_delta), plant.electrical_angle_rad(), present, settings, dt_s);
 }
 
 void StallGuardModel::update_ideal(const board::StepperDrive& drive, const StallGuardSettings& settings,
@@ -56,12 +67,26 @@ void StallGuardModel::update_ideal(const board::StepperDrive& drive, const Stall
   const double rotor = started_ ? static_cast<double>(field_position_ + static_cast<int32_t>(drive.electrical_angle - last_angle_)) *
                                       (kTwoPi / kElectricalCircle)
                                 : static_cast<double>(drive.electrical_angle) * (kTwoPi / kElectricalCircle);
-  update_with_angles(drive, 0.0, rotor, drive.coil_a_ma != 0 || drive.coil_b_ma != 0, settings, dt_s);
+  update_with_load(drive, 0.0, rotor, drive.coil_a_ma != 0 || drive.coil_b_ma != 0, settings, dt_s);
 }
 
 void StallGuardModel::update_with_angles(const board::StepperDrive& drive, double load_angle_rad,
                                         double rotor_electrical_rad, bool current_present,
                                         const StallGuardSettings& settings, double dt_s) {
+  const double delta = load_angle_rad - kTwoPi * std::nearbyint(load_angle_rad / kTwoPi);  // wrapped
+  update_with_load(drive, load_term(std::sin(delta), std::cos(delta)), rotor_electrical_rad, current_present, settings,
+                   dt_s);
+}
+
+// Past 90° the motor is beyond its torque limit (the torque falls again as the rotor slips back):
+// the full available torque is used.
+double StallGuardModel::load_term(double sin_delta, double cos_delta) {
+  return cos_delta > 0.0 ? sin_delta : (sin_delta > 0.0 ? 1.0 : -1.0);
+}
+
+void StallGuardModel::update_with_load(const board::StepperDrive& drive, double load_term,
+                                       double rotor_electrical_rad, bool current_present,
+                                       const StallGuardSettings& settings, double dt_s) {
   if (!drive.enabled) {
     // Bridges off: nothing is measured; the driver's results read 0.
     const uint32_t count = measurements_;
@@ -69,7 +94,6 @@ void StallGuardModel::update_with_angles(const board::StepperDrive& drive, doubl
     measurements_ = count;
     return;
   }
-  const double delta = wrap_angle(load_angle_rad);
   if (!started_) {
     started_ = true;
     last_angle_ = drive.electrical_angle;
@@ -89,9 +113,7 @@ void StallGuardModel::update_with_angles(const board::StepperDrive& drive, doubl
   still_s_ = field_change == 0 ? still_s_ + dt_s : 0.0;
   if (still_s_ < kPauseS + 0.5 * dt_s) window_s_ += dt_s;
   window_field_ += field_change;
-  // Past 90° the motor is beyond its torque limit (the torque falls again as the rotor slips
-  // back): the full available torque is used.
-  sum_sin_dt_ += (std::fabs(delta) < 0.5 * kPi ? std::sin(delta) : (delta > 0.0 ? 1.0 : -1.0)) * dt_s;
+  sum_sin_dt_ += load_term * dt_s;
   if (!current_present) no_current_ = true;
 
   constexpr int64_t kFullStep = int64_t{1} << kFullStepShift;

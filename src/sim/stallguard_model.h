@@ -60,7 +60,7 @@ class StallGuardModel {
   // The same for a motor without a physical load angle (sim::IdealStepper): load angle 0 while
   // the rotor follows the field.
   void update_ideal(const board::StepperDrive& drive, const StallGuardSettings& settings, double dt_s);
-  // The core of both: the load angle (rad, current vector minus rotor, any value) and the rotor's
+  // The same from the load angle (rad, current vector minus rotor, any value) and the rotor's
   // continuous electrical angle (rad) seen this tick.
   void update_with_angles(const board::StepperDrive& drive, double load_angle_rad, double rotor_electrical_rad,
                           bool current_present, const StallGuardSettings& settings, double dt_s);
@@ -77,6 +77,11 @@ class StallGuardModel {
   void reset();
 
  private:
+  // The core of all three: the load's share of the available torque this tick (sin of the load angle
+  // δ within ±90°, else ±1: load_term()) and the rotor's continuous electrical angle (rad).
+  void update_with_load(const board::StepperDrive& drive, double load_term, double rotor_electrical_rad,
+                        bool current_present, const StallGuardSettings& settings, double dt_s);
+  static double load_term(double sin_delta, double cos_delta);
   void complete_full_step(const StallGuardSettings& settings, int direction);
   void start_window();
 

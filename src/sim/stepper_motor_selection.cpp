@@ -41,7 +41,7 @@ std::string number_text(double value) {
 // The plant integrates the rotor explicitly: a stiff, light rotor would diverge. Names the key
 // that usually needs changing (the inertia) with the smallest value this motor allows.
 Result<void> check_stability(const StepperMotorDescription& motor) {
-  const double sub_step_s = StepperPlant::kBoardTickS / StepperPlant::kDefaultSubSteps;
+  const double sub_step_s = StepperPlant::kBoardTickS / StepperPlant::kFinestSubSteps;
   if (StepperPlant::step_number(motor, sub_step_s) <= StepperPlant::kStableStepNumber) return {};
   return Error{"\"rotor_inertia_kg_m2\" must be at least " +
                number_text(StepperPlant::min_stable_inertia_kg_m2(motor, sub_step_s)) +

@@ -114,15 +114,34 @@ double StepperPlant::min_stable_inertia_kg_m2(const StepperMotorDescription& mot
 }
 
 StepperPlant::StepperPlant(const StepperMotorDescription& motor, int sub_steps)
-    : motor_(motor), sub_steps_(sub_steps < 1 ? 1 : sub_steps) {
+    : motor_(motor), sub_steps_(sub_steps < 1 ? kAdaptiveSubSteps : sub_steps) {
   pole_pairs_ = motor_.full_steps_per_revolution / 4.0;
   inverse_inertia_ = 1.0 / motor_.rotor_inertia_kg_m2;
+  sync_electrical_angle();
 }
 
 void StepperPlant::update_step_constants(double dt_s) {
   step_dt_s_ = dt_s;
-  sub_step_s_ = dt_s / sub_steps_;
-  decay_ = std::exp(-sub_step_s_ * motor_.resistance_ohm / motor_.inductance_h);
+  active_sub_steps_ = sub_steps_;
+  if (sub_steps_ == kAdaptiveSubSteps) {
+    // The fewest sub-steps that integrate the rotor with its present inertia accurately.
+    StepperMotorDescription loaded = motor_;
+    loaded.rotor_inertia_kg_m2 = motor_.rotor_inertia_kg_m2 + load_inertia_kg_m2_;
+    active_sub_steps_ = 1;
+    while (active_sub_steps_ < kFinestSubSteps && step_number(loaded, dt_s / active_sub_steps_) > kAccurateStepNumber) {
+      active_sub_steps_ *= 2;
+    }
+  }
+  sub_step_s_ = dt_s / active_sub_steps_;
+  rate_ = motor_.resistance_ohm / motor_.inductance_h;
+  decay_ = std::exp(-sub_step_s_ * rate_);
+  inverse_rise_ = 1.0 / (1.0 - decay_);
+}
+
+void StepperPlant::sync_electrical_angle() {
+  const double angle = pole_pairs_ * kTwoPi * position_rev_;
+  sin_e_ = std::sin(angle);
+  cos_e_ = std::cos(angle);
 }
 
 double StepperPlant::velocity_rps() const { return omega_rad_s_ / kTwoPi; }
@@ -130,13 +149,13 @@ double StepperPlant::velocity_rps() const { return omega_rad_s_ / kTwoPi; }
 double StepperPlant::electrical_angle_rad() const { return pole_pairs_ * kTwoPi * position_rev_; }
 
 double StepperPlant::motor_torque_nm() const {
-  const double angle = electrical_angle_rad();
-  return motor_.torque_constant_nm_per_a * (-current_a_ * std::sin(angle) + current_b_ * std::cos(angle));
+  return motor_.torque_constant_nm_per_a * (-current_a_ * sin_e_ + current_b_ * cos_e_);
 }
 
 void StepperPlant::set_load_inertia_kg_m2(double inertia) {
   load_inertia_kg_m2_ = inertia < 0.0 ? 0.0 : inertia;
   inverse_inertia_ = 1.0 / (motor_.rotor_inertia_kg_m2 + load_inertia_kg_m2_);
+  step_dt_s_ = -1.0;  // the adaptive sub-steps depend on the inertia
 }
 
 void StepperPlant::set_blocked(bool blocked) {
@@ -147,30 +166,87 @@ void StepperPlant::set_blocked(bool blocked) {
 void StepperPlant::set_position_revolutions(double position) {
   position_rev_ = position;
   omega_rad_s_ = 0.0;
+  sync_electrical_angle();
+}
+
+// The rotor over one step h by leapfrog (half a step of turning, the torque at that midpoint
+// angle, the speed, the other half): symplectic like semi-implicit Euler, with the same stability
+// limit, but second order, so that the torque over a whole tick is that of the tick's mean angle
+// (semi-implicit Euler over one tick would take it at the tick's start angle, a lag of a whole
+// tick of turning). (s, c): sin and cos of the electrical angle, turned with the rotor.
+void StepperPlant::rotor_leapfrog_step(double& s, double& c, double h) {
+  const double k = motor_.torque_constant_nm_per_a;
+  const double friction = motor_.friction_torque_nm;
+  const auto turn = [&](double omega, double dt) {
+    if (omega == 0.0) return;
+    position_rev_ += omega * dt * (1.0 / kTwoPi);
+    const double turned = pole_pairs_ * omega * dt;  // electrical, rad
+    if (std::fabs(turned) < 0.25) {
+      rotate(s, c, turned);
+    } else {
+      const double angle = pole_pairs_ * kTwoPi * position_rev_;
+      s = std::sin(angle);
+      c = std::cos(angle);
+    }
+  };
+  turn(omega_rad_s_, 0.5 * h);
+  // sin 4θ from the double-angle formulas (the detent has four periods per electrical one).
+  const double detent = motor_.detent_torque_nm * 4.0 * s * c * (c * c - s * s);
+  const double drive_torque =
+      k * (-current_a_ * s + current_b_ * c) - detent - load_torque_nm_ - motor_.viscous_friction_nm_s * omega_rad_s_;
+  if (omega_rad_s_ == 0.0 && std::fabs(drive_torque) <= friction) return;  // static friction holds
+  const double moving = omega_rad_s_ != 0.0 ? sign(omega_rad_s_) : sign(drive_torque);
+  const double next = omega_rad_s_ + (drive_torque - friction * moving) * inverse_inertia_ * h;
+  // Friction stops the rotor rather than reversing it.
+  omega_rad_s_ = (omega_rad_s_ != 0.0 && next * omega_rad_s_ < 0.0) ? 0.0 : next;
+  turn(omega_rad_s_, 0.5 * h);
 }
 
 void StepperPlant::advance(const board::StepperDrive& drive, double supply_volt, double dt_s) {
   if (dt_s != step_dt_s_) update_step_constants(dt_s);
   const double h = sub_step_s_;
   const double k = motor_.torque_constant_nm_per_a;
-  const CoilStep coil{motor_.resistance_ohm, 1.0 / motor_.resistance_ohm, decay_, 1.0 / (1.0 - decay_),
+  const CoilStep coil{motor_.resistance_ohm, 1.0 / motor_.resistance_ohm, decay_, inverse_rise_,
                       supply_volt > 0.0 ? supply_volt : 0.0};
   // Open bridges: the current can only decay through the freewheeling diodes (towards 0 at up
   // to the supply voltage), which the chopper with target 0 models.
   const double target_a = drive.enabled ? drive.coil_a_ma * 1e-3 : 0.0;
   const double target_b = drive.enabled ? drive.coil_b_ma * 1e-3 : 0.0;
   const double radians_per_revolution = pole_pairs_ * kTwoPi;
-  // sin and cos of the electrical angle: exact at the tick's start, turned with the rotor
-  // through the sub-steps (one sincos per tick).
-  double s = std::sin(radians_per_revolution * position_rev_);
-  double c = std::cos(radians_per_revolution * position_rev_);
-  for (int i = 0; i < sub_steps_; ++i) {
+  const bool exact_emf = sub_steps_ == kAdaptiveSubSteps;
+  // sin and cos of the electrical angle: exact at the tick's start (computed at the end of the
+  // last one), turned with the rotor through the sub-steps.
+  double s = sin_e_;
+  double c = cos_e_;
+  for (int i = 0; i < active_sub_steps_; ++i) {
     // Back-EMF of each coil (V): the time derivative of its flux linkage K cos / K sin.
-    const double emf_a = -k * omega_rad_s_ * s;
-    const double emf_b = k * omega_rad_s_ * c;
+    double emf_a = -k * omega_rad_s_ * s;
+    double emf_b = k * omega_rad_s_ * c;
+    if (exact_emf && omega_rad_s_ != 0.0) {
+      // The rotor turns by phi over the step at its initial speed: the coils see the back-EMF
+      // K w exp(j (theta + w_e t)) (B the real part, A minus the imaginary part) weighted by the
+      // RL response, i.e. times W = a / (1 - d) (exp(j phi) - d) / (a + j w_e), a = R / L.
+      const double omega_e = pole_pairs_ * omega_rad_s_;
+      const double phi = omega_e * h;
+      const double p2 = phi * phi;
+      const double sin_phi = phi * (1.0 - p2 * (1.0 / 6.0) * (1.0 - p2 * (1.0 / 20.0)));
+      const double cos_phi = 1.0 - p2 * 0.5 * (1.0 - p2 * (1.0 / 12.0));
+      const double nr = (std::fabs(phi) < 0.25 ? cos_phi : std::cos(phi)) - decay_;
+      const double ni = std::fabs(phi) < 0.25 ? sin_phi : std::sin(phi);
+      const double scale = rate_ * inverse_rise_ / (rate_ * rate_ + omega_e * omega_e);
+      const double wr = (nr * rate_ + ni * omega_e) * scale;
+      const double wi = (ni * rate_ - nr * omega_e) * scale;
+      const double kw = k * omega_rad_s_;
+      emf_b = kw * (c * wr - s * wi);
+      emf_a = -kw * (c * wi + s * wr);
+    }
     current_a_ = coil(current_a_, target_a, emf_a);
     current_b_ = coil(current_b_, target_b, emf_b);
     if (blocked_) continue;  // (omega is 0: the angle stays)
+    if (exact_emf) {
+      rotor_leapfrog_step(s, c, h);
+      continue;
+    }
     // sin 4θ from the double-angle formulas (the detent has four periods per electrical one).
     const double detent = motor_.detent_torque_nm * 4.0 * s * c * (c * c - s * s);
     const double drive_torque = k * (-current_a_ * s + current_b_ * c) - detent - load_torque_nm_ -
@@ -190,6 +266,8 @@ void StepperPlant::advance(const board::StepperDrive& drive, double supply_volt,
       c = std::cos(radians_per_revolution * position_rev_);
     }
   }
+  // Exact again for the tick's end (what StallGuard and the next tick read).
+  sync_electrical_angle();
 }
 
 // --- IdealStepper ---------------------------------------------------------------------------

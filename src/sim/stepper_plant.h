@@ -2,9 +2,14 @@
 // with its load, the ideal motor that follows the field exactly, and the motor-side sensors (ABN
 // encoder with index, limit and home switches). Shared by the TMCM-142 and TMCM-3216 simulations.
 //
-// StepperPlant integrates in double precision with sub-steps per control tick: the coil currents
-// by the exact exponential update of the RL circuits under a chopper that forces them to their
-// targets while the supply voltage suffices, the rotor by semi-implicit Euler. Torque
+// StepperPlant integrates in double precision: the coil currents by the exact exponential update
+// of the RL circuits under a chopper that forces them to their targets while the supply voltage
+// suffices (with the back-EMF of the rotor turning at the step's initial speed integrated
+// exactly over the step), the rotor by leapfrog (the torque at the step's midpoint angle). By default a tick is one step when
+// the rotor's step number allows it accurately (kAccurateStepNumber; the presets), else 2 or 4
+// sub-steps; a fixed sub-step count (>= 1) takes the earlier integrator (back-EMF held over each
+// sub-step, the rotor by semi-implicit Euler), kept as the reference the default is tested
+// against. Torque
 // K (-ia sin θe + ib cos θe) - detent sin 4θe - friction - load; θe = (full steps per rev / 4) x
 // the mechanical angle. Step loss is not programmed: it happens when the load angle passes 90°
 // electrical. Equations and defaults: docs/stepper-motion.md.
@@ -37,7 +42,15 @@ struct StepperMotorDescription {
 
 class StepperPlant {
  public:
-  static constexpr int kDefaultSubSteps = 4;
+  // Sub-step choice: kAdaptiveSubSteps (the default) takes 1, 2 or 4 sub-steps per tick, the
+  // fewest with step_number() <= kAccurateStepNumber (at most kFinestSubSteps, whose stability
+  // the motor check guarantees); n >= 1 is the reference integrator with n sub-steps.
+  static constexpr int kAdaptiveSubSteps = 0;
+  static constexpr int kFinestSubSteps = 4;
+  static constexpr int kReferenceSubSteps = 4;  // what every tick took before
+  static constexpr int kDefaultSubSteps = kAdaptiveSubSteps;
+  // Semi-implicit Euler's frequency error is about step number^2 / 24: 0.25 keeps it below 0.3 %.
+  static constexpr double kAccurateStepNumber = 0.125;
   // The control tick of the boards that use the plant (TMCM-142 and TMCM-3216: 50 µs).
   static constexpr double kBoardTickS = 50e-6;
   // The largest peak coil current a module drives (TMCM-142: 7 A); the stability check assumes it.
@@ -68,6 +81,11 @@ class StepperPlant {
   // The rotor's electrical angle, rad, continuous: 0 when the rotor sits where the field of
   // electrical angle 0 (coil A only, positive) holds it.
   double electrical_angle_rad() const;
+  // sin and cos of electrical_angle_rad(), exact (computed once per tick for the next tick's start).
+  double electrical_sin() const { return sin_e_; }
+  double electrical_cos() const { return cos_e_; }
+  // The sub-steps a tick takes now (adaptive: 1, 2 or 4).
+  int sub_steps() const { return active_sub_steps_; }
 
   // A constant torque pulling towards negative positions (a weight that positive moves lift);
   // negative values pull towards positive positions.
@@ -82,9 +100,12 @@ class StepperPlant {
 
  private:
   void update_step_constants(double dt_s);
+  void sync_electrical_angle();
+  void rotor_leapfrog_step(double& s, double& c, double h);
 
   StepperMotorDescription motor_;
-  int sub_steps_;
+  int sub_steps_;          // as asked: kAdaptiveSubSteps or a fixed count
+  int active_sub_steps_ = kFinestSubSteps;
   // State.
   double position_rev_ = 0.0;
   double omega_rad_s_ = 0.0;
@@ -100,6 +121,10 @@ class StepperPlant {
   double step_dt_s_ = -1.0;   // tick length the step constants were computed for
   double sub_step_s_ = 0.0;
   double decay_ = 0.0;        // exp(-h R / L)
+  double inverse_rise_ = 0.0; // 1 / (1 - decay_)
+  double rate_ = 0.0;         // R / L
+  double sin_e_ = 0.0;        // of the electrical angle at position_rev_
+  double cos_e_ = 1.0;
 };
 
 // The ideal motor: the rotor follows the commanded electrical angle exactly, unwrapped (at most

@@ -389,7 +389,7 @@ TEST(StepperSensors, huge_and_non_finite_positions_are_defined) {
 // The stability bound the stepper JSON parser applies: the presets lie far inside it, and a
 // rotor just above the smallest stable inertia holds its position at the stiffest current.
 TEST(StepperPlant, rotor_integration_is_stable_above_the_minimum_inertia) {
-  const double h = kDt / StepperPlant::kDefaultSubSteps;
+  const double h = kDt / StepperPlant::kFinestSubSteps;
   EXPECT_LT(StepperPlant::step_number(StepperMotorDescription::nema17(), h), 0.06);
   EXPECT_LT(StepperPlant::step_number(StepperMotorDescription::nema23(), h), 0.03);
   StepperMotorDescription light = StepperMotorDescription::nema23();

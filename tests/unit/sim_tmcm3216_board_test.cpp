@@ -39,7 +39,8 @@ struct Rig {
   Tmcm3216GeneralIo io;
 
   Rig() = default;
-  explicit Rig(const StepperMotorDescription& motor) : board(motor) {}
+  explicit Rig(const StepperMotorDescription& motor, int sub_steps = StepperPlant::kDefaultSubSteps)
+      : board(motor, sub_steps) {}
 
   void enable(uint8_t axis) {
     demands[axis].power_enabled = true;

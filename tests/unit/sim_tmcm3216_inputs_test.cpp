@@ -197,7 +197,7 @@ PpResult pp_move(Rig& rig, uint16_t full_steps, int32_t target) {
 
 TEST(Tmcm3216SimInputs, FullStepResolution400MovesA09DegreeMotorOneRevolutionPer102400Microsteps) {
   const StepperMotorDescription motor = nema17_0_9_degree();
-  ASSERT_LE(StepperPlant::step_number(motor, StepperPlant::kBoardTickS / StepperPlant::kDefaultSubSteps),
+  ASSERT_LE(StepperPlant::step_number(motor, StepperPlant::kBoardTickS / StepperPlant::kFinestSubSteps),
             StepperPlant::kStableStepNumber);
   Rig rig(motor);
   const PpResult r = pp_move(rig, 400, 102400);
