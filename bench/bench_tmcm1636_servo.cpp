@@ -1,8 +1,8 @@
 // Simulation speed of one TMCM-1636 axis as a real-time factor (simulated seconds per second of
 // CPU time, one core): the full cascade (position P, velocity PI, FOC flux/torque PI, SVM) at the
-// 50 µs tick on the motor plant with its sub-steps, sensors and supply bus. The baseline,
-// measured in the same run, is the ideal motor (the axis follows its ramp, no regulators, no
-// plant). Goal: at least 200x for the full cascade. See docs/benchmarks.md.
+// 50 µs tick on the motor plant (one exact current step per tick), sensors and supply bus. The
+// baseline, measured in the same run, is the ideal motor (the axis follows its ramp, no
+// regulators, no plant). Goal: at least 200x for the full cascade. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 
 #include <memory>
