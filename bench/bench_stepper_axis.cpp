@@ -1,7 +1,7 @@
 // Simulation speed of one stepper axis (the TMCM-142's, each of the TMCM-3216's) as a real-time
 // factor (simulated seconds per second of CPU time, one core): per 50 µs tick the S-ramp, the
-// microstep table and the motor (hybrid stepper plant with 1 or 2 steps per tick, or the ideal motor), and
-// the encoder and switch sensors. The baseline, measured in the same run, is the S-ramp alone.
+// microstep table and the motor (hybrid stepper plant with 1 or 2 steps per tick, or the ideal
+// motor), and the encoder and switch sensors. The baseline, measured in the same run, is the S-ramp alone.
 // Goal: well above 200x for the whole axis. See docs/benchmarks.md.
 #include <benchmark/benchmark.h>
 
