@@ -5,11 +5,11 @@
 // StepperPlant integrates in double precision: the coil currents by the exact exponential update
 // of the RL circuits under a chopper that forces them to their targets while the supply voltage
 // suffices (with the back-EMF of the rotor turning at the step's initial speed integrated
-// exactly over the step), the rotor by leapfrog (the torque at the step's midpoint angle). By default a tick is one step when
-// the rotor's step number allows it accurately (kAccurateStepNumber; the presets), else 2 or 4
-// sub-steps; a fixed sub-step count (>= 1) takes the earlier integrator (back-EMF held over each
-// sub-step, the rotor by semi-implicit Euler), kept as the reference the default is tested
-// against. Torque
+// exactly over the step), the rotor by leapfrog (the torque at the step's midpoint angle). By
+// default a tick takes 1, 2 or 4 steps, the fewest its rotor step number allows accurately
+// (kAccurateStepNumber: NEMA17 2, NEMA23 1); a fixed sub-step count (>= 1) takes the earlier
+// integrator (back-EMF held over each sub-step, the rotor by semi-implicit Euler), kept as the
+// reference the default is tested against. Torque
 // K (-ia sin θe + ib cos θe) - detent sin 4θe - friction - load; θe = (full steps per rev / 4) x
 // the mechanical angle. Step loss is not programmed: it happens when the load angle passes 90°
 // electrical. Equations and defaults: docs/stepper-motion.md.
@@ -49,7 +49,9 @@ class StepperPlant {
   static constexpr int kFinestSubSteps = 4;
   static constexpr int kReferenceSubSteps = 4;  // what every tick took before
   static constexpr int kDefaultSubSteps = kAdaptiveSubSteps;
-  // Semi-implicit Euler's frequency error is about step number^2 / 24: 0.25 keeps it below 0.3 %.
+  // The integrators' frequency error is about step number^2 / 24 (0.07 % at 0.125); 0.125 rather
+  // than 0.25 because a marginal load step (docs/stepper-motion.md) pulls out at one NEMA17 step
+  // per tick and holds at two.
   static constexpr double kAccurateStepNumber = 0.125;
   // The control tick of the boards that use the plant (TMCM-142 and TMCM-3216: 50 µs).
   static constexpr double kBoardTickS = 50e-6;
