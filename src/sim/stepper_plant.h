@@ -83,7 +83,7 @@ class StepperPlant {
   // The rotor's electrical angle, rad, continuous: 0 when the rotor sits where the field of
   // electrical angle 0 (coil A only, positive) holds it.
   double electrical_angle_rad() const;
-  // sin and cos of electrical_angle_rad(), exact (computed once per tick for the next tick's start).
+  // sin and cos of electrical_angle_rad() (exact every millisecond, rotated with the rotor between).
   double electrical_sin() const { return sin_e_; }
   double electrical_cos() const { return cos_e_; }
   // The sub-steps a tick takes now (adaptive: 1, 2 or 4).
@@ -127,6 +127,8 @@ class StepperPlant {
   double rate_ = 0.0;         // R / L
   double sin_e_ = 0.0;        // of the electrical angle at position_rev_
   double cos_e_ = 1.0;
+  static constexpr int kTicksPerSync = 20;
+  int ticks_since_sync_ = 0;
 };
 
 // The ideal motor: the rotor follows the commanded electrical angle exactly, unwrapped (at most
