@@ -36,6 +36,8 @@ struct StepperFeedback {
   uint32_t stallguard_measurements = 0;
   // DRV_STATUS error bits (kDriver* below), as the TMCM-3216 shows them in object 2102.
   uint8_t driver_status = 0;
+
+  bool operator==(const StepperFeedback&) const = default;
 };
 
 // feedback.driver_status bits (TMCM-3216 manual table 159).
@@ -69,6 +71,8 @@ struct StepperDrive {
   bool stallguard4_filter = false;
   bool stallguard4_angle_offset = false;
   bool encoder_index_active_low = false;
+
+  bool operator==(const StepperDrive&) const = default;
 };
 
 struct StepperPowerStage {

@@ -128,6 +128,12 @@ class AxisDrive {
 
   // One motion tick.
   void step(const AxisInputs& inputs, uint32_t dt_us);
+  // What step() changes besides in an axis it otherwise leaves as it is: the time since the
+  // last SYNC. A module that has seen a step change nothing else, with nothing changed since,
+  // calls this instead (docs/tmcm-3216-drive.md "Idle ticks").
+  void rest(uint32_t dt_us) {
+    if (us_since_sync_ < kSyncAbsentUs) us_since_sync_ += dt_us;
+  }
 
   const AxisDemand& demand() const { return demand_; }
   // A position assignment (homing) for the stepper since the last call.

@@ -1,5 +1,8 @@
 #include "core/modules/tmcm3216/tmcm3216.h"
 
+#include <cstring>
+#include <type_traits>
+
 namespace motwin::modules::tmcm3216 {
 
 using canopen::NmtReset;
@@ -39,6 +42,7 @@ canopen::LssIdentity Tmcm3216::identity() const {
 }
 
 void Tmcm3216::power_up() {
+  axes_touched_ = true;
   receive_head_ = 0;
   receive_count_ = 0;
   reported_dropped_frames_ = dropped_frames_;
@@ -139,6 +143,7 @@ bool Tmcm3216::receive(const can::CanFrame& frame) {
 }
 
 void Tmcm3216::process(uint32_t elapsed_us) {
+  axes_touched_ = true;  // whatever the services do to the axes, their next tick is a full one
   const bool was_restarting = restarting_;
   while (receive_count_ > 0) {
     const can::CanFrame frame = receive_queue_[receive_head_];
@@ -469,15 +474,54 @@ void Tmcm3216::run_axes(uint32_t dt_us) {
   const uint8_t others = static_cast<uint8_t>(error_register_ | axis_error_register());
   if (emergencies_.update_shutdown(!board_.io.enable_input, emergency_, others).fault) {
     for (Tmcm3216Drive& drive : drives_) drive.external_fault();
+    axes_touched_ = true;
   }
   bool brake_control[kAxisCount] = {};
   uint8_t brake_duty[kAxisCount] = {};
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
-    run_axis(axis, dt_us);
+    const board::StepperPowerStage& stage = board_.axes[axis];
+    if (!axes_touched_ && axis_resting_[axis] && stage.feedback == resting_feedback_[axis] &&
+        stage.drive == resting_drive_[axis]) {
+      drives_[axis].rest(dt_us);
+      steppers_[axis].rest(dt_us);
+    } else {
+      run_axis_checking_rest(axis, dt_us);
+    }
     brake_control[axis] = steppers_[axis].brake_control();
     brake_duty[axis] = steppers_[axis].brake_duty();
   }
+  axes_touched_ = false;
   general_io_.drive(board_.io, brake_control, brake_duty);
+}
+
+void Tmcm3216::run_axis_checking_rest(uint8_t axis, uint32_t dt_us) {
+  // The proof is by comparison: a full tick whose result equals rest() applied to the state
+  // before it, with the same inputs, will do so again. The power stage must be off, because
+  // only then does no part of the tick read the counters rest() advances (the standstill time
+  // sets the standby current of a powered motor; the SYNC timeout is read by set-point writes,
+  // which come through process()).
+  static_assert(std::is_trivially_copyable_v<Tmcm3216Drive> && std::is_trivially_copyable_v<Tmcm3216Stepper> &&
+                std::is_trivially_copyable_v<Tmcm3216Emergencies>);
+  Tmcm3216Drive& drive = drives_[axis];
+  Tmcm3216Stepper& stepper = steppers_[axis];
+  const bool candidate = resting_enabled_ && !stepper.power_stage_on();
+  if (candidate) {
+    // Byte copies, so that the comparison below sees padding that the tick leaves alone as equal.
+    std::memcpy(static_cast<void*>(&rest_check_drive_), &drive, sizeof(drive));
+    std::memcpy(static_cast<void*>(&rest_check_stepper_), &stepper, sizeof(stepper));
+    std::memcpy(static_cast<void*>(&rest_check_emergencies_), &emergencies_, sizeof(emergencies_));
+    rest_check_drive_.rest(dt_us);
+    rest_check_stepper_.rest(dt_us);
+  }
+  const board::StepperPowerStage& stage = board_.axes[axis];
+  const board::StepperDrive drive_before = stage.drive;
+  run_axis(axis, dt_us);
+  axis_resting_[axis] = candidate && !stepper.power_stage_on() && stage.drive == drive_before &&
+                        std::memcmp(&rest_check_drive_, &drive, sizeof(drive)) == 0 &&
+                        std::memcmp(&rest_check_stepper_, &stepper, sizeof(stepper)) == 0 &&
+                        std::memcmp(&rest_check_emergencies_, &emergencies_, sizeof(emergencies_)) == 0;
+  resting_feedback_[axis] = stage.feedback;
+  resting_drive_[axis] = stage.drive;
 }
 
 void Tmcm3216::run_axis(uint8_t axis, uint32_t dt_us) {

@@ -157,7 +157,12 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr uint8_t kCommErrorPdoLengthExceeded = 0x08;
   static constexpr uint8_t kCommErrorCanController = 0x10;  // error-passive, bus-off, just recovered
 
-  Dictionary& dictionary() { return dictionary_; }
+  // The accessors that let a caller change the axes' objects or state directly wake the resting
+  // axes (run_axes()) as a frame does.
+  Dictionary& dictionary() {
+    axes_touched_ = true;
+    return dictionary_;
+  }
   canopen::NmtSlave& nmt() { return nmt_; }
   canopen::SdoServer& sdo() { return sdo_; }
   canopen::EmergencyProducer& emergency() { return emergency_; }
@@ -168,8 +173,24 @@ class Tmcm3216 final : private canopen::LssDevice {
   CommunicationConfig& communication() { return communication_; }
   NodeSettings& node_settings() { return node_settings_; }
   const Tmcm3216Config& config() const { return config_; }
-  Tmcm3216Drive& drive(uint8_t axis) { return drives_[axis]; }
-  Tmcm3216Stepper& stepper(uint8_t axis) { return steppers_[axis]; }
+  Tmcm3216Drive& drive(uint8_t axis) {
+    axes_touched_ = true;
+    return drives_[axis];
+  }
+  Tmcm3216Stepper& stepper(uint8_t axis) {
+    axes_touched_ = true;
+    return steppers_[axis];
+  }
+  const Tmcm3216Drive& drive(uint8_t axis) const { return drives_[axis]; }
+  const Tmcm3216Stepper& stepper(uint8_t axis) const { return steppers_[axis]; }
+  // Whether the axis rests: its last full tick changed nothing but the time counters, and it is
+  // stepped by rest() until a frame, a service tick or its board feedback changes (run_axes()).
+  bool axis_resting(uint8_t axis) const { return axis_resting_[axis]; }
+  // Tests: false makes every tick a full one (the reference for the resting axes' tests).
+  void set_resting_axes_enabled(bool enabled) {
+    resting_enabled_ = enabled;
+    axes_touched_ = true;
+  }
   Tmcm3216GeneralIo& general_io() { return general_io_; }
   const Tmcm3216Emergencies& emergencies() const { return emergencies_; }
   board::Tmcm3216Board& board() { return board_; }
@@ -188,6 +209,8 @@ class Tmcm3216 final : private canopen::LssDevice {
   void reset_application();
   void reset_axes();
   void run_axes(uint32_t dt_us);
+  // run_axis(), and whether it changed nothing but what rest() changes (the axis then rests).
+  void run_axis_checking_rest(uint8_t axis, uint32_t dt_us);
   void run_axis(uint8_t axis, uint32_t dt_us);
   // A SYNC seen or produced: csp/csv set-points of every axis (after the synchronous RPDOs).
   void sync_axes();
@@ -244,6 +267,19 @@ class Tmcm3216 final : private canopen::LssDevice {
   std::array<Tmcm3216Drive, kAxisCount> drives_{};
   Tmcm3216GeneralIo general_io_{};
   Tmcm3216Emergencies emergencies_{};  // table 365 per axis: the single sender of the axes' EMCYs
+  // Resting axes (docs/tmcm-3216-drive.md "Idle ticks"): an axis whose full tick changed nothing
+  // but its time counters, with its power stage off, is stepped by rest() while nothing that
+  // run_axis() reads changes: no process() call (frames, service ticks), no call of a mutable
+  // accessor, the same board feedback, the board's drive as the axis left it.
+  bool resting_enabled_ = true;
+  bool axes_touched_ = true;
+  std::array<bool, kAxisCount> axis_resting_{};
+  std::array<board::StepperFeedback, kAxisCount> resting_feedback_{};
+  std::array<board::StepperDrive, kAxisCount> resting_drive_{};
+  // The state before a full tick with rest() applied, to compare with the state after it.
+  Tmcm3216Drive rest_check_drive_{};
+  Tmcm3216Stepper rest_check_stepper_{};
+  Tmcm3216Emergencies rest_check_emergencies_{};
 
   Dictionary dictionary_;
   canopen::NmtSlave nmt_;

@@ -133,6 +133,11 @@ class Tmcm3216Stepper {
 
   // One tick: reads stage.feedback, writes stage.drive.
   void tick(board::StepperPowerStage& stage, const StepperDemand& demand, uint32_t dt_us);
+  // What tick() changes besides in a stepper it otherwise leaves as it is: the standstill time
+  // (Tmcm3216's resting axes, docs/tmcm-3216-drive.md "Idle ticks").
+  void rest(uint32_t dt_us) {
+    if (!moving_ && standstill_us_ < UINT64_MAX - dt_us) standstill_us_ += dt_us;
+  }
   // Power-up / NMT reset node: live state cleared, objects kept (loaded by the dictionary).
   void reset();
   // The drive assigns its position counter (homing, 200B sub 3): the next demand at `position`

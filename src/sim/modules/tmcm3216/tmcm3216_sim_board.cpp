@@ -1,6 +1,8 @@
 #include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 #include <cmath>
+#include <cstring>
+#include <type_traits>
 #include <iterator>
 #include <string>
 
@@ -154,6 +156,7 @@ void Tmcm3216SimBoard::set_rotor_revolutions(uint8_t axis, double position) {
   } else {
     a.ideal.set_position_revolutions(position);
   }
+  touched_ = true;
   sense_axis(axis);
 }
 
@@ -177,13 +180,46 @@ bool Tmcm3216SimBoard::pin_level(uint8_t dio) const {
   return io.push_pull[dio] ? false : dio_external_[dio];
 }
 
+void Tmcm3216SimBoard::copy_resting_state(const Axis& a, RestingState& out) {
+  static_assert(std::is_trivially_copyable_v<IdealStepper> && std::is_trivially_copyable_v<StepperSensors> &&
+                std::is_trivially_copyable_v<StallGuardModel> && std::is_trivially_copyable_v<StepperSwitchSources> &&
+                std::is_trivially_copyable_v<FreezableEncoder>);
+  unsigned char* at = out.data();
+  const auto put = [&at](const auto& part) {
+    std::memcpy(at, &part, sizeof(part));
+    at += sizeof(part);
+  };
+  put(a.ideal);
+  put(a.sensors);
+  put(a.stallguard);
+  put(a.switches);
+  put(a.encoder_freeze);
+  put(a.sensor_index_events);
+  put(a.reported_index_events);
+  put(a.reported_index_count);
+}
+
 void Tmcm3216SimBoard::before_tick() {
   board::Tmcm3216Io& io = board_.io;
   for (uint8_t n = 0; n < board::Tmcm3216Io::kDioCount; ++n) io.dio_levels[n] = pin_level(n);
   io.analog_inputs = analog_raw_;
   io.supply_millivolt = supply_millivolt_;
   io.enable_input = enable_input_;
-  for (uint8_t axis = 0; axis < kAxisCount; ++axis) sense_axis(axis);
+  for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
+    const board::StepperPowerStage& stage = board_.axes[axis];
+    // A resting axis senses what it sensed before: its rotor, inputs and drive are unchanged
+    // (after_tick() proved the tick a fixed point).
+    skipped_sensing_[axis] = !touched_ && resting_[axis] && stage.drive == resting_drive_[axis] &&
+                             stage.feedback == resting_feedback_[axis];
+    if (skipped_sensing_[axis]) continue;
+    const bool candidate = resting_enabled_ && !axes_[axis].plant;
+    if (candidate) {
+      copy_resting_state(axes_[axis], state_before_[axis]);
+      feedback_before_[axis] = stage.feedback;
+      drive_before_[axis] = stage.drive;
+    }
+    sense_axis(axis);
+  }
 }
 
 void Tmcm3216SimBoard::sense_axis(uint8_t axis) {
@@ -235,11 +271,25 @@ void Tmcm3216SimBoard::after_tick(double dt_s) {
       a.plant->set_blocked(a.blocked || brake_engaged(axis));
       a.plant->advance(drive, supply_volt, dt_s);
       a.stallguard.update(*a.plant, drive, settings, dt_s);
-    } else {
-      a.ideal.advance(drive, dt_s);
-      a.stallguard.update_ideal(drive, settings, dt_s);
+      continue;
+    }
+    const board::StepperPowerStage& stage = board_.axes[axis];
+    if (skipped_sensing_[axis] && stage.drive == resting_drive_[axis]) continue;  // the motor rests too
+    const bool sensed = !skipped_sensing_[axis];
+    a.ideal.advance(drive, dt_s);
+    a.stallguard.update_ideal(drive, settings, dt_s);
+    // A fixed point: the tick left the axis as it found it, the feedback the same, with the same
+    // drive throughout. The same inputs give the same tick again.
+    resting_[axis] = false;
+    if (sensed && resting_enabled_ && !touched_ && stage.drive == drive_before_[axis] &&
+        stage.feedback == feedback_before_[axis]) {
+      copy_resting_state(a, state_after_[axis]);
+      resting_[axis] = state_after_[axis] == state_before_[axis];
+      resting_drive_[axis] = stage.drive;
+      resting_feedback_[axis] = stage.feedback;
     }
   }
+  touched_ = false;
   for (uint8_t n = 0; n < board::Tmcm3216Io::kDioCount; ++n) {
     const int32_t level = board_.io.output_mode[n] && pin_level(n) ? 1 : 0;
     if (level != logged_dio_[n]) {
@@ -257,6 +307,7 @@ void Tmcm3216SimBoard::after_tick(double dt_s) {
 }
 
 void Tmcm3216SimBoard::set_input(std::string_view name, double value) {
+  touched_ = true;
   if (const SignalInfo* device = find_signal(kDeviceSignals, name)) {
     const auto index = static_cast<size_t>(device - kDeviceSignals);
     if (index < kAin0) {

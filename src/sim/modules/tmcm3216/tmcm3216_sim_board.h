@@ -60,6 +60,15 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   // Around each control tick of the firmware.
   void before_tick();
   void after_tick(double dt_s);
+  // Whether an axis with the ideal motor rests: its last full tick (sensing, the motor, the
+  // StallGuard model) changed nothing and gave the same feedback, so the next ones with the same
+  // drive and inputs are skipped (docs/tmcm-3216-drive.md "Idle ticks").
+  bool axis_resting(uint8_t axis) const { return resting_[axis]; }
+  // Tests: false makes every tick a full one.
+  void set_resting_axes_enabled(bool enabled) {
+    resting_enabled_ = enabled;
+    touched_ = true;
+  }
 
   // SignalBoard.
   std::span<const SignalInfo> input_signals() const override { return signal_table(); }
@@ -95,6 +104,11 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   void apply_motor_settings(uint8_t axis);
   void apply_sensor_config(uint8_t axis);
   void sense_axis(uint8_t axis);
+  // The parts of an axis with the ideal motor that a tick may change, as bytes.
+  static constexpr size_t kRestingStateBytes = sizeof(IdealStepper) + sizeof(StepperSensors) + sizeof(StallGuardModel) +
+                                               sizeof(StepperSwitchSources) + sizeof(FreezableEncoder) + 3 * sizeof(uint32_t);
+  using RestingState = std::array<unsigned char, kRestingStateBytes>;
+  static void copy_resting_state(const Axis& a, RestingState& out);
   bool pin_level(uint8_t dio) const;
   uint8_t brake_duty_seen(uint8_t axis) const;
   std::optional<double> read_axis_signal(uint8_t axis, size_t index) const;
@@ -108,6 +122,17 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   // Output logging.
   std::array<int32_t, board::Tmcm3216Io::kDioCount> logged_dio_{};
   std::array<int32_t, kAxisCount> logged_brake_{};
+  // Resting axes: what their last full tick started from and saw.
+  bool resting_enabled_ = true;
+  bool touched_ = true;  // an input was set or a rotor moved: the next tick is a full one
+  std::array<bool, kAxisCount> resting_{};
+  std::array<bool, kAxisCount> skipped_sensing_{};
+  std::array<board::StepperDrive, kAxisCount> resting_drive_{};
+  std::array<board::StepperFeedback, kAxisCount> resting_feedback_{};
+  std::array<board::StepperFeedback, kAxisCount> feedback_before_{};
+  std::array<board::StepperDrive, kAxisCount> drive_before_{};
+  std::array<RestingState, kAxisCount> state_before_{};
+  std::array<RestingState, kAxisCount> state_after_{};
 };
 
 }  // namespace motwin::sim
