@@ -53,6 +53,7 @@ for bench in "${benches[@]}"; do
   case "$bench" in
     bench_tcp_roundtrip) [ $quick = 1 ] && args=(--requests 3000) ;;
     bench_module_footprint) ;;
+    bench_bus_scale) [ $quick = 1 ] && args=(--quick) ;;
     *)
       # Google Benchmark programs; the others ignore unknown options only if they say so.
       if grep -q 'benchmark/benchmark.h' "bench/$bench.cpp"; then
@@ -179,6 +180,24 @@ interpreter = text("bench_interpreter")
 for m in re.finditer(r"^\s+(\S+)\s+([\d.]+) ms wall\s+([\d.]+)x real time\s+(?:([\d.]+)x baseline)?", interpreter, re.M):
     rows.append((f"TMCM-1636 module in fast pacing, interpreter: {m.group(1)}", f"{m.group(3)}x real time",
                  "idle_module_baseline" if m.group(4) else "(baseline)", f"{m.group(4)}x" if m.group(4) else ""))
+
+bus = text("bench_bus_scale")
+bus_row = r"\s+(\d+)\s+(idle|full)\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s+(\d+)\s+(kept|LAGS)"
+for module in ("TMCM-3216", "TMCM-1636"):
+    one = re.search(module + r"\s+1\s+idle\s+([\d.]+)", bus)
+    full = re.search(module + r"\s+127\s+full\s+([\d.]+)\s+([\d.]+)\s+(\d+)\s+(\d+)\s+(kept|LAGS)", bus)
+    per_node = re.search(r"idle cost per node, " + module + r": ([\d.]+) ms CPU per simulated second \(([\d.]+) %", bus)
+    traffic = ("heartbeats, SDO polling, 1 kHz SYNC with 3 RPDOs + 3 TPDOs to 8" if module == "TMCM-3216"
+               else "TMCL over CAN, a GAP every ms to 8 in turn")
+    if full:
+        rows.append((f"one serve with 127 {module} nodes ({traffic}): CPU per simulated second",
+                     f"{full.group(1)} s", f"1 idle node {one.group(1) if one else '?'} s",
+                     f"sim/wall {full.group(2)}, {'kept real time' if full.group(5) == 'kept' else 'fell behind'}"))
+    if per_node:
+        rows.append((f"idle {module} node on a bus (slope of 1..127 nodes)", f"{per_node.group(1)} ms CPU per sim s",
+                     "", f"{per_node.group(2)} % of a core"))
+if not bus.strip():
+    rows.append(("one serve with 127 nodes on a bus", "n/a", "", "bench_bus_scale failed or missing"))
 
 sizes = text("core_size")
 total = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+\S+\s+\(TOTALS\)", sizes, re.M)

@@ -98,8 +98,11 @@ Result<std::unique_ptr<SocketcandClient>> SocketcandClient::connect(const std::s
 
 SocketcandClient::~SocketcandClient() { ::close(fd_); }
 
-Result<void> SocketcandClient::send(const can::CanFrame& frame) {
-  const std::string text = host::format_socketcand_send(frame);
+Result<void> SocketcandClient::send(const can::CanFrame& frame) { return send(std::span<const can::CanFrame>(&frame, 1)); }
+
+Result<void> SocketcandClient::send(std::span<const can::CanFrame> frames) {
+  std::string text;
+  for (const can::CanFrame& frame : frames) text += host::format_socketcand_send(frame);
   if (::send(fd_, text.data(), text.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(text.size())) {
     return Error{"cannot send to the socketcand server"};
   }

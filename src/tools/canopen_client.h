@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,8 @@ class SocketcandClient {
 
   // Fails with "cannot send to the socketcand server" when the connection refuses the frame.
   Result<void> send(const can::CanFrame& frame);
+  // Several frames in one write (a master's round of SYNC and PDOs).
+  Result<void> send(std::span<const can::CanFrame> frames);
   // The next frame from the bus, or nullopt after `timeout_ms`.
   std::optional<can::CanFrame> receive(int timeout_ms);
   std::optional<ReceivedFrame> receive_stamped(int timeout_ms);
