@@ -1,8 +1,6 @@
 #include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 #include <cmath>
-#include <cstring>
-#include <type_traits>
 #include <iterator>
 #include <string>
 
@@ -180,25 +178,6 @@ bool Tmcm3216SimBoard::pin_level(uint8_t dio) const {
   return io.push_pull[dio] ? false : dio_external_[dio];
 }
 
-void Tmcm3216SimBoard::copy_resting_state(const Axis& a, RestingState& out) {
-  static_assert(std::is_trivially_copyable_v<IdealStepper> && std::is_trivially_copyable_v<StepperSensors> &&
-                std::is_trivially_copyable_v<StallGuardModel> && std::is_trivially_copyable_v<StepperSwitchSources> &&
-                std::is_trivially_copyable_v<FreezableEncoder>);
-  unsigned char* at = out.data();
-  const auto put = [&at](const auto& part) {
-    std::memcpy(at, &part, sizeof(part));
-    at += sizeof(part);
-  };
-  put(a.ideal);
-  put(a.sensors);
-  put(a.stallguard);
-  put(a.switches);
-  put(a.encoder_freeze);
-  put(a.sensor_index_events);
-  put(a.reported_index_events);
-  put(a.reported_index_count);
-}
-
 void Tmcm3216SimBoard::before_tick() {
   board::Tmcm3216Io& io = board_.io;
   for (uint8_t n = 0; n < board::Tmcm3216Io::kDioCount; ++n) io.dio_levels[n] = pin_level(n);
@@ -207,17 +186,12 @@ void Tmcm3216SimBoard::before_tick() {
   io.enable_input = enable_input_;
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
     const board::StepperPowerStage& stage = board_.axes[axis];
-    // A resting axis senses what it sensed before: its rotor, inputs and drive are unchanged
-    // (after_tick() proved the tick a fixed point).
+    // A resting axis senses what it sensed before: its rotor, inputs and drive are unchanged.
     skipped_sensing_[axis] = !touched_ && resting_[axis] && stage.drive == resting_drive_[axis] &&
                              stage.feedback == resting_feedback_[axis];
     if (skipped_sensing_[axis]) continue;
-    const bool candidate = resting_enabled_ && !axes_[axis].plant;
-    if (candidate) {
-      copy_resting_state(axes_[axis], state_before_[axis]);
-      feedback_before_[axis] = stage.feedback;
-      drive_before_[axis] = stage.drive;
-    }
+    feedback_before_[axis] = stage.feedback;
+    drive_before_[axis] = stage.drive;
     sense_axis(axis);
   }
 }
@@ -278,16 +252,16 @@ void Tmcm3216SimBoard::after_tick(double dt_s) {
     const bool sensed = !skipped_sensing_[axis];
     a.ideal.advance(drive, dt_s);
     a.stallguard.update_ideal(drive, settings, dt_s);
-    // A fixed point: the tick left the axis as it found it, the feedback the same, with the same
-    // drive throughout. The same inputs give the same tick again.
-    resting_[axis] = false;
-    if (sensed && resting_enabled_ && !touched_ && stage.drive == drive_before_[axis] &&
-        stage.feedback == feedback_before_[axis]) {
-      copy_resting_state(a, state_after_[axis]);
-      resting_[axis] = state_after_[axis] == state_before_[axis];
-      resting_drive_[axis] = stage.drive;
-      resting_feedback_[axis] = stage.feedback;
-    }
+    // Rests from here: the drive seen before this tick (applied by the previous after_tick) and
+    // now is the same, with the bridges off. Then the motor holds its position at velocity 0 and
+    // the StallGuard model stays reset (count kept) whatever it was, and sensing the same rotor
+    // with the same inputs again gives the same feedback (the N-pulse and filter bookkeeping
+    // caught up in this tick's sensing), so the next ticks change nothing. Without a signal set
+    // or a rotor moved in between, and with this tick's feedback the same as the last one.
+    resting_[axis] = sensed && resting_enabled_ && !touched_ && !stage.drive.enabled &&
+                     stage.drive == drive_before_[axis] && stage.feedback == feedback_before_[axis];
+    resting_drive_[axis] = stage.drive;
+    resting_feedback_[axis] = stage.feedback;
   }
   touched_ = false;
   for (uint8_t n = 0; n < board::Tmcm3216Io::kDioCount; ++n) {

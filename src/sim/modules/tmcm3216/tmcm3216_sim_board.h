@@ -60,9 +60,9 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   // Around each control tick of the firmware.
   void before_tick();
   void after_tick(double dt_s);
-  // Whether an axis with the ideal motor rests: its last full tick (sensing, the motor, the
-  // StallGuard model) changed nothing and gave the same feedback, so the next ones with the same
-  // drive and inputs are skipped (docs/tmcm-3216-drive.md "Idle ticks").
+  // Whether an axis with the ideal motor rests: its bridges were off through its last two full
+  // ticks with the same drive, which leaves sensing, motor and StallGuard model as they are, so
+  // the next ticks with the same drive and inputs are skipped (docs/tmcm-3216-drive.md "Idle ticks").
   bool axis_resting(uint8_t axis) const { return resting_[axis]; }
   // Tests: false makes every tick a full one.
   void set_resting_axes_enabled(bool enabled) {
@@ -104,11 +104,6 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   void apply_motor_settings(uint8_t axis);
   void apply_sensor_config(uint8_t axis);
   void sense_axis(uint8_t axis);
-  // The parts of an axis with the ideal motor that a tick may change, as bytes.
-  static constexpr size_t kRestingStateBytes = sizeof(IdealStepper) + sizeof(StepperSensors) + sizeof(StallGuardModel) +
-                                               sizeof(StepperSwitchSources) + sizeof(FreezableEncoder) + 3 * sizeof(uint32_t);
-  using RestingState = std::array<unsigned char, kRestingStateBytes>;
-  static void copy_resting_state(const Axis& a, RestingState& out);
   bool pin_level(uint8_t dio) const;
   uint8_t brake_duty_seen(uint8_t axis) const;
   std::optional<double> read_axis_signal(uint8_t axis, size_t index) const;
@@ -131,8 +126,6 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   std::array<board::StepperFeedback, kAxisCount> resting_feedback_{};
   std::array<board::StepperFeedback, kAxisCount> feedback_before_{};
   std::array<board::StepperDrive, kAxisCount> drive_before_{};
-  std::array<RestingState, kAxisCount> state_before_{};
-  std::array<RestingState, kAxisCount> state_after_{};
 };
 
 }  // namespace motwin::sim
