@@ -34,6 +34,7 @@
 #include <thread>
 #include <vector>
 
+#include "find_motwin.h"
 #include "tools/canopen_client.h"
 #include "tools/serve_process.h"
 
@@ -47,15 +48,7 @@ int fail(const std::string& message) {
   return 2;
 }
 
-std::optional<std::string> find_motwin_next_to_this_program() {
-  std::error_code error;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (error) return std::nullopt;
-  for (const std::filesystem::path& candidate : {self.parent_path() / "motwin", self.parent_path().parent_path() / "motwin"}) {
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
-  }
-  return std::nullopt;
-}
+using motwin::bench::find_motwin_next_to_this_program;
 
 // User + system CPU seconds of a process so far.
 std::optional<double> process_cpu_seconds(pid_t pid) {

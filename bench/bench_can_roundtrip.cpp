@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "find_motwin.h"
 #include "host/socketcand_protocol.h"
 #include "tools/canopen_client.h"
 #include "tools/serve_process.h"
@@ -44,15 +45,7 @@ int fail(const std::string& message) {
   return 2;
 }
 
-std::optional<std::string> find_motwin_next_to_this_program() {
-  std::error_code error;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (error) return std::nullopt;
-  for (const std::filesystem::path& candidate : {self.parent_path() / "motwin", self.parent_path().parent_path() / "motwin"}) {
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
-  }
-  return std::nullopt;
-}
+using motwin::bench::find_motwin_next_to_this_program;
 
 // A bare socketcand server for one client: the session handshake, then each `< send ID ... >`
 // is answered with a frame on ID - 0x80 (0x601 -> 0x581: an SDO server's reply ID) carrying the

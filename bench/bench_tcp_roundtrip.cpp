@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "find_motwin.h"
 #include "core/tmcl/serial_link.h"
 #include "host/tmcl_host_service.h"
 #include "tools/fd_io.h"
@@ -56,16 +57,7 @@ int fail(const std::string& message) {
   return 2;
 }
 
-// `motwin` is at build/motwin, the benchmarks at build/bench/.
-std::optional<std::string> find_motwin_next_to_this_program() {
-  std::error_code error;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (error) return std::nullopt;
-  for (const std::filesystem::path& candidate : {self.parent_path() / "motwin", self.parent_path().parent_path() / "motwin"}) {
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
-  }
-  return std::nullopt;
-}
+using motwin::bench::find_motwin_next_to_this_program;
 
 std::optional<Options> parse_options(int argc, char** argv) {
   Options options;
