@@ -7,6 +7,11 @@
 #   scripts/fuzz.sh --smoke [SECONDS]   the test command's bounded run: every target from the seeds,
 #                                       in a scratch corpus, sharing SECONDS in total (default 150,
 #                                       start-up included; at least 3 s per target)
+#   scripts/fuzz.sh --campaign SECONDS [RUNS] [TARGET...]
+#                                       a recorded long run: every target (or the ones named) in turn
+#                                       for SECONDS or RUNS executions (0: no limit), whichever comes
+#                                       first, on build-fuzz/corpus/TARGET; each appends a row to the
+#                                       campaign table of fuzz/README.md
 #   scripts/fuzz.sh --list              the targets
 #
 # A crash or a violated invariant stops the run with exit status 1 and leaves the input in
@@ -18,7 +23,7 @@ build=${MOTWIN_FUZZ_BUILD:-build-fuzz}
 jobs=$(nproc 2>/dev/null || echo 2)
 
 usage() {
-  sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 [ $# -ge 1 ] || usage
@@ -27,6 +32,17 @@ seconds=${2:-}
 if [ -n "$seconds" ] && ! [[ $seconds =~ ^[0-9]+$ ]]; then
   echo "fuzz: SECONDS must be a whole number, not '$seconds'" >&2
   exit 2
+fi
+campaign_runs=0
+campaign_targets=()
+if [ "$mode" = --campaign ]; then
+  [ -n "$seconds" ] || usage
+  shift 2
+  if [ $# -gt 0 ] && [[ $1 =~ ^[0-9]+$ ]]; then
+    campaign_runs=$1
+    shift
+  fi
+  campaign_targets=("$@")
 fi
 
 if ! command -v clang++ >/dev/null; then
@@ -66,7 +82,87 @@ run_target() {  # target seconds corpus-dir
   return 1
 }
 
+# One campaign row: | date | commit | target | seconds | CPU s | executions | exec/s | cov | ft |
+# corpus | findings |, appended to the table under "## Campaigns" in fuzz/README.md.
+campaign_commit() {
+  local commit
+  commit=$(git rev-parse --short=10 HEAD 2>/dev/null || echo unknown)
+  if ! git diff --quiet HEAD -- src fuzz CMakeLists.txt ":!fuzz/README.md" 2>/dev/null; then commit="$commit+changes"; fi
+  echo "$commit"
+}
+
+campaign_target() {  # target seconds runs
+  local target=$1 time=$2 runs=$3 log corpus findings before after start elapsed cpu
+  corpus="$build/corpus/$target"
+  mkdir -p "$corpus" "$build/campaign"
+  log="$build/campaign/$target-$(date -u +%Y%m%dT%H%M%S).log"
+  before=$(find "$build/artifacts" -maxdepth 1 -name "$target-*" ! -name '*.log' | sort)
+  start=$(date +%s.%N)
+  # -runs counts every execution (seed replay included); -print_final_stats=1 gives the totals and
+  # the last status line cov/ft. The sanitizer options and -timeout are the smoke's.
+  local limits=(-max_total_time="$time")
+  [ "$runs" -eq 0 ] || limits+=(-runs="$runs")
+  /usr/bin/time -f 'cpu_seconds: %U %S' -o "$log.time" "$build/fuzz_$target" "${limits[@]}" -timeout=10 \
+    -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$build/artifacts/$target-" "$corpus" \
+    "fuzz/corpus/$target" >"$log" 2>&1 || true
+  elapsed=$(echo "$(date +%s.%N) - $start" | bc)
+  cpu=$(awk '/cpu_seconds/ {printf "%.0f", $2 + $3}' "$log.time" 2>/dev/null || echo "?")
+  local executions rate status cov ft corp
+  executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)
+  status=$(grep -E '^#[0-9]+' "$log" | tail -1)
+  [ -n "$executions" ] || executions=$(echo "$status" | grep -o '^#[0-9]*' | tr -d '#')
+  cov=$(echo "$status" | grep -o 'cov: [0-9]*' | grep -o '[0-9]*$' || true)
+  ft=$(echo "$status" | grep -o 'ft: [0-9]*' | grep -o '[0-9]*$' || true)
+  corp=$(echo "$status" | grep -o 'corp: [0-9]*/[0-9]*[a-zA-Z]*' | sed 's/corp: //' || true)
+  rate=$(awk -v n="${executions:-0}" -v s="$elapsed" 'BEGIN {printf "%d", (s > 0 ? n / s : 0)}')
+  after=$(find "$build/artifacts" -maxdepth 1 -name "$target-*" ! -name '*.log' | sort)
+  findings=$(comm -13 <(echo "$before") <(echo "$after") | xargs -r -n1 basename | sed 's/^'"$target"'-//' |
+    paste -sd ' ' -)
+  if [ -n "$findings" ]; then
+    findings="$(grep -m1 -oE 'invariant violated at [^ ]*|ERROR: [A-Za-z]+: [a-z-]+|ERROR: libFuzzer: [a-z-]+|runtime error: .{0,50}' "$log" |
+      head -1 | tr '|' '/'): $findings"
+    cp "$log" "$build/artifacts/$target.log"
+  else
+    findings=none
+  fi
+  printf '  %-20s %6.0f s %10s executions %7s/s cov %s ft %s corpus %s, findings: %s\n' "$target" "$elapsed" \
+    "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$findings"
+  local row
+  row=$(printf '| %s | %s | %s | %.0f | %s | %s | %s | %s | %s | %s | %s |' "$(date -u +%Y-%m-%d)" \
+    "$(campaign_commit)" "$target" "$elapsed" "$cpu" "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" \
+    "${corp:-?}" "$findings")
+  # Append under the table's last row (the table is the last block of lines starting with '|' after
+  # the "## Campaigns" heading).
+  awk -v row="$row" '
+    { lines[NR] = $0 }
+    /^## Campaigns/ { section = NR }
+    END {
+      last = 0
+      for (i = section + 1; i <= NR && section; ++i) if (lines[i] ~ /^\|/) last = i; else if (last) break
+      for (i = 1; i <= NR; ++i) { print lines[i]; if (i == last) print row }
+      if (!last) print row
+    }' fuzz/README.md >fuzz/README.md.new && mv fuzz/README.md.new fuzz/README.md
+  [ "$findings" = none ]
+}
+
 case "$mode" in
+  --campaign)
+    if [ ${#campaign_targets[@]} -eq 0 ]; then campaign_targets=("${targets[@]}"); fi
+    for target in "${campaign_targets[@]}"; do
+      if ! printf '%s\n' "${targets[@]}" | grep -qx "$target"; then
+        echo "fuzz: no target '$target'; targets: ${targets[*]}" >&2
+        exit 2
+      fi
+    done
+    grep -q '^## Campaigns' fuzz/README.md || { echo "fuzz: fuzz/README.md has no '## Campaigns' table" >&2; exit 1; }
+    status=0
+    printf 'fuzz campaign: %s s%s per target, commit %s\n' "$seconds" \
+      "$([ "$campaign_runs" -gt 0 ] && echo " or $campaign_runs executions")" "$(campaign_commit)"
+    for target in "${campaign_targets[@]}"; do
+      campaign_target "$target" "$seconds" "$campaign_runs" || status=1
+    done
+    exit $status
+    ;;
   --list)
     printf '%s\n' "${targets[@]}"
     ;;
