@@ -1,12 +1,16 @@
 // Shared by the libFuzzer targets in this folder: the invariant check and small module rigs
-// (a TMCM-1636 and a TMCM-3216 on RAM EEPROMs). Each target builds a fresh module per input, so
-// an input replays the same way under `scripts/fuzz.sh` and when a crash file is run again.
+// (a TMCM-1636 and a TMCM-3216 on RAM EEPROMs). Each input gets a fresh rig (fresh_rig(): the
+// process's one rig constructed anew in place), so an input replays the same way under
+// `scripts/fuzz.sh` and when a crash file is run again.
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
+#include <new>
 #include <vector>
 
 #include "board/can_controller.h"
@@ -44,31 +48,54 @@ class FixedTmcm1636Io final : public board::Tmcm1636Io {
   std::array<bool, 16> outputs_{};
 };
 
+// A module's factory EEPROM image, formatted once per process (the same bytes every time).
+template <typename Module, size_t kSize>
+const std::array<uint8_t, kSize>& factory_image() {
+  static const std::array<uint8_t, kSize> image = [] {
+    std::array<uint8_t, kSize> bytes{};
+    Module::format_factory_image(bytes.data(), bytes.size());
+    return bytes;
+  }();
+  return image;
+}
+
+// Each input's rig is a freshly constructed one, but built in the same memory every time: the
+// previous input's rig is destroyed and a new one constructed in its place. A heap allocation per
+// input cost more than the construction (AddressSanitizer hands out fresh, page-faulting memory
+// for each), and only the modules' public constructors and power-up are used, so the rig stays
+// what `new Rig` gives. `Rig::state()` is what the rigs are compared by: on the first input and
+// then every 2^16th, the reused rig must equal one built on the heap. A target that needs two
+// rigs at once gives the second another `kSlot`.
+constexpr uint64_t kRigComparisonPeriod = 1 << 16;
+
+template <typename Rig, int kSlot = 0>
+Rig& fresh_rig() {
+  alignas(Rig) static std::byte storage[sizeof(Rig)];
+  static Rig* rig = nullptr;
+  static uint64_t inputs = 0;
+  if (rig != nullptr) std::destroy_at(rig);
+  rig = std::construct_at(reinterpret_cast<Rig*>(storage));
+  if (inputs++ % kRigComparisonPeriod == 0) {
+    const auto built_on_heap = std::make_unique<Rig>();
+    FUZZ_CHECK(rig->state() == built_on_heap->state(), "a rig built in place differs from one built on the heap");
+  }
+  return *rig;
+}
+
 using Tmcm1636 = modules::tmcm1636::Tmcm1636;
 using Tmcm1636Nvm = board::RamNonVolatileMemory<Tmcm1636::kNvmLayout.total_size>;
 
-// Heap-allocated once per input: the module with its program memory is a few KiB.
-struct Tmcm1636Rig {
-  Tmcm1636Nvm nvm;
-  FixedTmcm1636Io io;
-  Tmcm1636 module{nvm, io};
-  tmcl::TmclEngine& engine{module.engine()};
-
-  Tmcm1636Rig() {
-    Tmcm1636::format_factory_image(nvm.mutable_data(), nvm.size());
-    engine.power_up();
-  }
-};
-
-// Every readable parameter of bank 0 and every axis parameter, as GAP/GGP see them.
-inline std::vector<int32_t> probe_parameters(Tmcm1636& module) {
+// Every readable parameter of bank 0 and every axis parameter, as GAP/GGP see them, plus banks
+// 1..3 (user variables and the module's banks).
+template <typename Module>
+std::vector<int32_t> probe_parameters(Module& module) {
   std::vector<int32_t> values;
-  for (const auto& row : Tmcm1636::axis_parameters().rows()) {
+  for (const auto& row : module.axis_table().rows()) {
     int32_t value = 0;
     const auto status = module.get_axis_parameter(static_cast<uint8_t>(row.info.number), 0, value);
     values.push_back(static_cast<int32_t>(status) * 7919 + value);
   }
-  for (const auto& row : Tmcm1636::global_parameters().rows()) {
+  for (const auto& row : Module::global_parameters().rows()) {
     int32_t value = 0;
     const auto status = module.get_global_parameter(static_cast<uint8_t>(row.info.number), 0, value);
     values.push_back(static_cast<int32_t>(status) * 7919 + value);
@@ -83,15 +110,40 @@ inline std::vector<int32_t> probe_parameters(Tmcm1636& module) {
   return values;
 }
 
+// The parameters and the EEPROM image: what a fresh rig is compared by.
+template <typename Module, typename Nvm>
+std::vector<int32_t> module_state(Module& module, const Nvm& nvm) {
+  std::vector<int32_t> values = probe_parameters(module);
+  values.insert(values.end(), nvm.data(), nvm.data() + nvm.size());
+  return values;
+}
+
+// A TMCM-1636 on a RAM EEPROM with the factory image, powered up (fresh_rig<Tmcm1636Rig>()).
+struct Tmcm1636Rig {
+  Tmcm1636Nvm nvm;
+  FixedTmcm1636Io io;
+  Tmcm1636 module{nvm, io};
+  tmcl::TmclEngine& engine{module.engine()};
+
+  Tmcm1636Rig() {
+    const auto& image = factory_image<Tmcm1636, Tmcm1636::kNvmLayout.total_size>();
+    std::memcpy(nvm.mutable_data(), image.data(), image.size());
+    engine.power_up();
+  }
+  std::vector<int32_t> state() { return module_state(module, nvm); }
+};
+
 // A writable axis parameter (motor 0) holds a value inside its row's range, whatever came before.
+// The rows' getters are called directly, as get_axis_parameter() does after finding the row (a
+// search per parameter cost about half of each input's time).
 template <typename Module>
 void check_axis_parameter_ranges(Module& module, const char* when) {
-  for (const auto& row : Module::axis_parameters().rows()) {
-    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
+  for (const auto& row : module.axis_table().rows()) {
+    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead) ||
+        row.binding.get == nullptr) {
       continue;
     }
-    int32_t value = 0;
-    if (module.get_axis_parameter(static_cast<uint8_t>(row.info.number), 0, value) != tmcl::Status::kOk) continue;
+    const int32_t value = row.binding.get(module, 0);
     FUZZ_CHECK(params::in_range(row.info, value), "%s: AP %u (%.*s) holds %d, range %lld..%lld", when,
                row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
                static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
@@ -102,11 +154,11 @@ void check_axis_parameter_ranges(Module& module, const char* when) {
 template <typename Module>
 void check_global_parameter_ranges(Module& module, const char* when) {
   for (const auto& row : Module::global_parameters().rows()) {
-    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead)) {
+    if (!params::has(row.info.access, params::Access::kWrite) || !params::has(row.info.access, params::Access::kRead) ||
+        row.binding.get == nullptr) {
       continue;
     }
-    int32_t value = 0;
-    if (module.get_global_parameter(static_cast<uint8_t>(row.info.number), 0, value) != tmcl::Status::kOk) continue;
+    const int32_t value = row.binding.get(module, 0);  // bank 0
     FUZZ_CHECK(params::in_range(row.info, value), "%s: GP %u (%.*s) holds %d, range %lld..%lld", when,
                row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
                static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
@@ -133,16 +185,49 @@ class RecordingCan final : public board::CanController {
 using Tmcm3216 = modules::tmcm3216::Tmcm3216;
 using Tmcm3216Nvm = board::RamNonVolatileMemory<Tmcm3216::kNvmSize>;
 
-struct Tmcm3216Rig {
-  std::unique_ptr<Tmcm3216Nvm> nvm = std::make_unique<Tmcm3216Nvm>();
-  RecordingCan can;
-  std::unique_ptr<Tmcm3216> device;
-
-  Tmcm3216Rig() {
-    Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
-    device = std::make_unique<Tmcm3216>(*nvm, can);
-    device->power_up();
+// Every readable numeric object of every axis (its SDO abort where it has none) and the EEPROM
+// image: what a fresh TMCM-3216 rig is compared by.
+inline std::vector<int64_t> dictionary_state(Tmcm3216& device, const Tmcm3216Nvm& nvm) {
+  std::vector<int64_t> values;
+  auto& dictionary = device.dictionary();
+  const auto rows = dictionary.rows();
+  for (size_t row = 0; row < rows.size(); ++row) {
+    const canopen::EntryInfo& info = rows[row].info;
+    const uint8_t axes = info.axis_stride == 0 ? 1 : dictionary.axis_count();
+    for (uint8_t axis = 0; axis < axes; ++axis) {
+      const canopen::ObjectRef ref{&info, row, static_cast<uint16_t>(info.index + axis * info.axis_stride), axis};
+      uint8_t bytes[64] = {};
+      size_t length = 0;
+      const canopen::SdoAbort abort = dictionary.read(ref, bytes, sizeof(bytes), length);
+      values.push_back(static_cast<int64_t>(abort));
+      for (size_t i = 0; i < length; ++i) values.push_back(bytes[i]);
+    }
   }
+  values.push_back(device.node_id());
+  values.push_back(static_cast<int64_t>(device.nmt_state()));
+  values.push_back(device.restarting());
+  values.insert(values.end(), nvm.data(), nvm.data() + nvm.size());
+  return values;
+}
+
+// A TMCM-3216 (communication only: the board of its own) on a RAM EEPROM with the factory image,
+// powered up (fresh_rig<Tmcm3216Rig>()).
+struct Tmcm3216Rig {
+  Tmcm3216Nvm nvm_storage;
+  // The image is in place before the module is constructed (members initialise in this order).
+  struct FactoryImage {
+    explicit FactoryImage(Tmcm3216Nvm& memory) {
+      const auto& image = factory_image<Tmcm3216, Tmcm3216::kNvmSize>();
+      std::memcpy(memory.mutable_data(), image.data(), image.size());
+    }
+  } factory_image_copied{nvm_storage};
+  Tmcm3216Nvm* nvm = &nvm_storage;
+  RecordingCan can;
+  Tmcm3216 device_storage{nvm_storage, can};
+  Tmcm3216* device = &device_storage;
+
+  Tmcm3216Rig() { device->power_up(); }
+  std::vector<int64_t> state() { return dictionary_state(*device, *nvm); }
 };
 
 }  // namespace motwin::fuzz

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -94,16 +95,32 @@ can::CanFrame sdo_download(Tmcm3216& device, uint16_t index, uint8_t sub, int64_
   return frame;
 }
 
+// The module on its sim board, on a RAM EEPROM with the factory image, powered up; one per input
+// (fuzz::fresh_rig).
+struct DriveRig {
+  fuzz::Tmcm3216Nvm nvm;
+  struct FactoryImage {  // in place before the module is constructed
+    explicit FactoryImage(fuzz::Tmcm3216Nvm& memory) {
+      const auto& image = fuzz::factory_image<Tmcm3216, Tmcm3216::kNvmSize>();
+      std::memcpy(memory.mutable_data(), image.data(), image.size());
+    }
+  } factory_image_copied{nvm};
+  fuzz::RecordingCan can;
+  sim::Tmcm3216SimBoard board;
+  Tmcm3216 device{nvm, can, board.board()};
+
+  DriveRig() { device.power_up(); }
+  std::vector<int64_t> state() { return fuzz::dictionary_state(device, nvm); }
+};
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  auto nvm = std::make_unique<fuzz::Tmcm3216Nvm>();
-  Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
-  fuzz::RecordingCan can;
-  auto board = std::make_unique<sim::Tmcm3216SimBoard>();
-  auto device = std::make_unique<Tmcm3216>(*nvm, can, board->board());
-  device->power_up();
+  DriveRig& rig = fuzz::fresh_rig<DriveRig>();
+  fuzz::RecordingCan& can = rig.can;
+  sim::Tmcm3216SimBoard* board = &rig.board;
+  Tmcm3216* device = &rig.device;
   can.frames.clear();
   const auto signals = sim::Tmcm3216SimBoard::signal_table();
   fuzz::SdoClientView client(*device);
