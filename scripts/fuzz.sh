@@ -129,7 +129,7 @@ campaign_target() {  # target seconds runs
     "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" "${corp:-?}" "$findings"
   local row
   row=$(printf '| %s | %s | %s | %.0f | %s | %s | %s | %s | %s | %s | %s |' "$(date -u +%Y-%m-%d)" \
-    "$(campaign_commit)" "$target" "$elapsed" "$cpu" "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" \
+    "$built_commit" "$target" "$elapsed" "$cpu" "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" \
     "${corp:-?}" "$findings")
   # Append under the table's last row (the table is the last block of lines starting with '|' after
   # the "## Campaigns" heading).
@@ -156,8 +156,9 @@ case "$mode" in
     done
     grep -q '^## Campaigns' fuzz/README.md || { echo "fuzz: fuzz/README.md has no '## Campaigns' table" >&2; exit 1; }
     status=0
+    built_commit=$(campaign_commit)  # what the targets were built from, whatever happens to the tree later
     printf 'fuzz campaign: %s s%s per target, commit %s\n' "$seconds" \
-      "$([ "$campaign_runs" -gt 0 ] && echo " or $campaign_runs executions")" "$(campaign_commit)"
+      "$([ "$campaign_runs" -gt 0 ] && echo " or $campaign_runs executions")" "$built_commit"
     for target in "${campaign_targets[@]}"; do
       campaign_target "$target" "$seconds" "$campaign_runs" || status=1
     done
