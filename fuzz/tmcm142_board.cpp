@@ -126,12 +126,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
 
   constexpr uint32_t kTicks = 100 * modules::tmcm142::kTicksPerMillisecond;
+  // Only an input (a scenario event) sets ENCODER_FAULT: read again when inputs changed.
+  bool encoder_fault = board->read_signal("ENCODER_FAULT") != 0.0;
   for (uint32_t tick = 0; tick < kTicks; ++tick) {
     const uint64_t now_us = uint64_t{tick} * modules::tmcm142::kControlTickUs;
     io->set_sim_time_us(now_us);
     const bool inputs_changed = player.apply_due(now_us) != 0;
+    if (inputs_changed) encoder_fault = board->read_signal("ENCODER_FAULT") != 0.0;
     board->before_tick();
-    if (!inputs_changed && board->read_signal("ENCODER_FAULT") == 0.0) {
+    if (!inputs_changed && !encoder_fault) {
       // The count the firmware sees is the one the sensors compute from the rotor position.
       const int32_t expected = board->sensors().encoder_count_at(board->rotor_revolutions());
       FUZZ_CHECK(board->power_stage().feedback.encoder_count == expected, "encoder count %d, rotor says %d at tick %u",
