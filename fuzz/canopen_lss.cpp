@@ -41,7 +41,7 @@ uint32_t identity(fuzz::Tmcm3216& device, uint8_t sub) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  fuzz::Tmcm3216Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
   fuzz::Tmcm3216& device = *rig->device;
   rig->can.frames.clear();
   for (int step = 0; step < 200 && in.remaining_bytes() > 0; ++step) {

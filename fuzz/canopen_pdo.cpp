@@ -209,7 +209,7 @@ class PdoFuzzer {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  fuzz::Tmcm3216Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
   rig->can.frames.clear();
   PdoFuzzer(in, *rig).run();
   return 0;

@@ -52,7 +52,7 @@ can::CanFrame next_sdo_request(FuzzedDataProvider& in, fuzz::Tmcm3216& device) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  fuzz::Tmcm3216Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm3216Rig>();
   fuzz::Tmcm3216& device = *rig->device;
   rig->can.frames.clear();
   fuzz::SdoClientView client(device);

@@ -1,6 +1,6 @@
 // Shared by the libFuzzer targets in this folder: the invariant check and small module rigs
-// (a TMCM-1636 and a TMCM-3216 on RAM EEPROMs). Each input gets a fresh rig (fresh_rig(): the
-// process's one rig constructed anew in place), so an input replays the same way under
+// (a TMCM-1636 and a TMCM-3216 on RAM EEPROMs). Each input gets a fresh rig (fresh_rig(): a rig
+// constructed in the same static memory for every input), so an input replays the same way under
 // `scripts/fuzz.sh` and when a crash file is run again.
 #pragma once
 
@@ -59,27 +59,41 @@ const std::array<uint8_t, kSize>& factory_image() {
   return image;
 }
 
-// Each input's rig is a freshly constructed one, but built in the same memory every time: the
-// previous input's rig is destroyed and a new one constructed in its place. A heap allocation per
-// input cost more than the construction (AddressSanitizer hands out fresh, page-faulting memory
-// for each), and only the modules' public constructors and power-up are used, so the rig stays
-// what `new Rig` gives. `Rig::state()` is what the rigs are compared by: on the first input and
-// then every 2^16th, the reused rig must equal one built on the heap. A target that needs two
+// Each input's rig is a freshly constructed one, but built in the same memory every time: a rig is
+// constructed in a static buffer at the start of an input and destroyed at its end (when the
+// returned handle goes), so an input allocates and frees on the heap only what the modules do, as
+// before, and libFuzzer's per-input leak detection stays balanced. A heap allocation of the rig per
+// input cost more than its construction (AddressSanitizer hands out fresh, page-faulting memory
+// each time); only the modules' public constructors and power-up are used, so the rig stays what
+// `new Rig` gives. `Rig::state()` is what the rigs are compared by: on the first input and then
+// every 2^16th, the rig built in place must equal one built on the heap. A target that needs two
 // rigs at once gives the second another `kSlot`.
 constexpr uint64_t kRigComparisonPeriod = 1 << 16;
 
+template <typename Rig>
+struct DestroyInPlace {
+  bool* in_use;
+  void operator()(Rig* rig) const {
+    std::destroy_at(rig);
+    *in_use = false;
+  }
+};
+template <typename Rig>
+using RigHandle = std::unique_ptr<Rig, DestroyInPlace<Rig>>;
+
 template <typename Rig, int kSlot = 0>
-Rig& fresh_rig() {
+RigHandle<Rig> fresh_rig() {
   alignas(Rig) static std::byte storage[sizeof(Rig)];
-  static Rig* rig = nullptr;
+  static bool in_use = false;
   static uint64_t inputs = 0;
-  if (rig != nullptr) std::destroy_at(rig);
-  rig = std::construct_at(reinterpret_cast<Rig*>(storage));
+  FUZZ_CHECK(!in_use, "fresh_rig: the slot's previous rig is still in use");
+  in_use = true;
+  RigHandle<Rig> rig(std::construct_at(reinterpret_cast<Rig*>(storage)), DestroyInPlace<Rig>{&in_use});
   if (inputs++ % kRigComparisonPeriod == 0) {
     const auto built_on_heap = std::make_unique<Rig>();
     FUZZ_CHECK(rig->state() == built_on_heap->state(), "a rig built in place differs from one built on the heap");
   }
-  return *rig;
+  return rig;
 }
 
 using Tmcm1636 = modules::tmcm1636::Tmcm1636;

@@ -173,10 +173,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const uint8_t echo_bits = data[0] & 0x30;
   if ((data[0] & 1) == 0) {
-    fuzz::Tmcm1636Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
+    auto rig = fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
     type_at(rig->module, rig->engine, echo_bits, data + 1, size - 1);
   } else {
-    fuzz::Tmcm142Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm142Rig>();
+    auto rig = fuzz::fresh_rig<fuzz::Tmcm142Rig>();
     type_at(*rig->module, rig->engine(), echo_bits, data + 1, size - 1);
   }
   return 0;

@@ -28,7 +28,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace motwin;
   FuzzedDataProvider in(data, size);
-  fuzz::Tmcm1636Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
   tmcl::CanSettings settings;
   if (!tmcl::read_can_settings(rig->module, settings)) return 0;
   size_t executed = 0;
@@ -98,7 +98,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::check_parameter_ranges(rig->module, "after a CAN frame");
   }
   if (executed == 0) {
-    fuzz::Tmcm1636Rig* fresh = &fuzz::fresh_rig<fuzz::Tmcm1636Rig, 1>();
+    const auto fresh = fuzz::fresh_rig<fuzz::Tmcm1636Rig, 1>();
     for (uint64_t t = 0; t < ticks; ++t) fresh->module.tick();
     FUZZ_CHECK(fuzz::probe_parameters(rig->module) == fuzz::probe_parameters(fresh->module),
                "frames that executed nothing changed a parameter");

@@ -20,7 +20,7 @@ using namespace motwin;
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  fuzz::Tmcm1636Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
   for (int step = 0; step < 256 && in.remaining_bytes() > 0; ++step) {
     if (in.ConsumeIntegralInRange<int>(0, 7) == 0) {
       const int ticks = in.ConsumeIntegralInRange<int>(1, 400);

@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   data += 1;
   size -= 1;
 
-  fuzz::Tmcm1636Rig* rig = &fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
+  auto rig = fuzz::fresh_rig<fuzz::Tmcm1636Rig>();
   tmcl::SerialFrameDecoder decoder;
   uint64_t now_us = 1000;
   size_t model_fill = 0;

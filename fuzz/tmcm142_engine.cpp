@@ -38,7 +38,7 @@ void check_motor(Rig& rig) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  Rig* rig = &fuzz::fresh_rig<Rig>();
+  auto rig = fuzz::fresh_rig<Rig>();
   tmcl::TmclEngine& engine = rig->engine();
   int ticks_left = 20'000;  // 1 s of motion per input at most
   for (int step = 0; step < 256 && in.remaining_bytes() > 0; ++step) {

@@ -117,7 +117,8 @@ struct DriveRig {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
-  DriveRig& rig = fuzz::fresh_rig<DriveRig>();
+  const auto rig_in_place = fuzz::fresh_rig<DriveRig>();
+  DriveRig& rig = *rig_in_place;
   fuzz::RecordingCan& can = rig.can;
   sim::Tmcm3216SimBoard* board = &rig.board;
   Tmcm3216* device = &rig.device;
