@@ -203,6 +203,22 @@ TEST(MotorDescription, axis_parameters_in_number_order_and_each_number_once) {
             "r.json: axis_parameters: parameter 5 is given twice");
 }
 
+// Found by the fuzz campaign: a torque constant or KV inside its own range can give a flux linkage
+// outside flux_linkage_wb's, and the description was then written back in a form that did not load.
+TEST(MotorDescription, a_derived_flux_linkage_stays_in_the_range_it_is_written_back_with) {
+  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 2, "torque_constant_nm_per_a": 50.35})", "kt.json").error(),
+            "kt.json: torque_constant_nm_per_a with 2 pole pairs gives a flux linkage of 16.7833 Wb; it must be from "
+            "1e-06 to 10");
+  EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 200, "kv_rpm_per_v": 90000})", "kv.json").error(),
+            "kv.json: kv_rpm_per_v with 200 pole pairs gives a flux linkage of 3.06296e-07 Wb; it must be from "
+            "1e-06 to 10");
+  const Result<MotorDescription> edge = parse_motor_description(R"({"pole_pairs": 2, "torque_constant_nm_per_a": 30})", "ok.json");
+  ASSERT_TRUE(edge) << edge.error();
+  const Result<MotorDescription> again = parse_motor_description(motor_description_json(*edge), "again.json");
+  ASSERT_TRUE(again) << again.error();
+  EXPECT_DOUBLE_EQ(again->flux_linkage_wb, 10.0);
+}
+
 TEST(MotorDescription, errors_name_the_file_and_the_problem) {
   EXPECT_EQ(parse_motor_description("{", "a.json").error(), "a.json: not valid JSON");
   EXPECT_EQ(parse_motor_description(R"({"pole_pairs": 4, "flux_linkage_wb": 0.005, "resistanse_ohm": 1})", "b.json").error(),

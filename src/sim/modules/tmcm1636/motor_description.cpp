@@ -474,10 +474,12 @@ void read_kind(Reader& top, MotorDescription& m) {
 // or a BLDC motor's flux linkage, torque constant or KV. After "type" and "pole_pairs". A preset's
 // stays when the file gives none.
 void read_magnet_strength(Reader& top, MotorDescription& m, bool from_preset) {
+  constexpr double kMinFluxLinkageWb = 1e-6;
+  constexpr double kMaxFluxLinkageWb = 10.0;
   double flux = -1.0;
   double kt = -1.0;
   double kv = -1.0;
-  top.number("flux_linkage_wb", flux, 1e-6, 10.0);
+  top.number("flux_linkage_wb", flux, kMinFluxLinkageWb, kMaxFluxLinkageWb);
   top.number("torque_constant_nm_per_a", kt, 1e-5, 100.0);
   top.number("kv_rpm_per_v", kv, 0.1, 1e5);
   if (from_preset && flux <= 0.0 && kt <= 0.0 && kv <= 0.0) return;
@@ -487,10 +489,19 @@ void read_magnet_strength(Reader& top, MotorDescription& m, bool from_preset) {
     m.pole_pairs = 1;
   } else if (flux > 0.0) {
     m.flux_linkage_wb = flux;
-  } else if (kt > 0.0) {
-    m.flux_linkage_wb = kt / (1.5 * m.pole_pairs);
-  } else if (kv > 0.0) {
-    m.flux_linkage_wb = (8.27 / kv) / (1.5 * m.pole_pairs);  // Kt = 8.27 / KV (ODrive, moteus)
+  } else if (kt > 0.0 || kv > 0.0) {
+    const char* given = kt > 0.0 ? "torque_constant_nm_per_a" : "kv_rpm_per_v";
+    const double kt_nm_per_a = kt > 0.0 ? kt : 8.27 / kv;  // Kt = 8.27 / KV (ODrive, moteus)
+    const double derived = kt_nm_per_a / (1.5 * m.pole_pairs);
+    // The derived flux linkage is what the file is written back with: it must load again
+    // (found by fuzz/motor_description.cpp: Kt 50 N·m/A on 2 pole pairs is 16.8 Wb).
+    if (derived < kMinFluxLinkageWb || derived > kMaxFluxLinkageWb) {
+      std::ostringstream text;
+      text << given << " with " << m.pole_pairs << " pole pairs gives a flux linkage of " << derived
+           << " Wb; it must be from " << kMinFluxLinkageWb << " to " << kMaxFluxLinkageWb;
+      return top.fail(text.str());
+    }
+    m.flux_linkage_wb = derived;
   } else {
     top.fail("give one of flux_linkage_wb, torque_constant_nm_per_a or kv_rpm_per_v");
   }
