@@ -139,7 +139,6 @@ void SocketcandClientEndpoint::connect_now() {
   SocketcandClientSession::Io& io = *this;
   session_ = std::make_unique<SocketcandClientSession>(io, channel_);
   output_.clear();
-  output_sent_ = 0;
   fd_ = ::socket(address_.ss_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd_ < 0) {
     const std::string reason = std::string("cannot open a socket: ") + std::strerror(errno);
@@ -188,24 +187,9 @@ void SocketcandClientEndpoint::read_some() {
 }
 
 void SocketcandClientEndpoint::flush() {
-  while (fd_ >= 0 && !connecting_ && output_sent_ < output_.size()) {
-    const ssize_t n = ::send(fd_, output_.data() + output_sent_, output_.size() - output_sent_,
-                             MSG_DONTWAIT | MSG_NOSIGNAL);
-    if (n > 0) {
-      output_sent_ += static_cast<size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      break;
-    } else {
-      return lose(n == 0 ? "the connection failed" : std::strerror(errno));
-    }
-  }
   if (fd_ < 0 || connecting_) return;
-  if (output_sent_ == output_.size()) {
-    output_.clear();
-    output_sent_ = 0;
-  }
+  std::string error;
+  if (output_.send_to(fd_, &error) == SocketOutput::Sent::kFailed) return lose(error);
   loop_.set_events(fd_, output_.empty() ? POLLIN : static_cast<short>(POLLIN | POLLOUT));
 }
 
@@ -218,7 +202,6 @@ void SocketcandClientEndpoint::lose(const std::string& reason) {
   fd_ = -1;
   connecting_ = false;
   output_.clear();
-  output_sent_ = 0;
   if (starting_) {
     start_failure_ = reason;
     return;
@@ -237,7 +220,7 @@ void SocketcandClientEndpoint::lose(const std::string& reason) {
 
 void SocketcandClientEndpoint::write(const std::string& element) {
   if (fd_ < 0) return;
-  output_ += element;
+  output_.append(element);
   flush();
 }
 
@@ -252,7 +235,7 @@ void SocketcandClientEndpoint::failed(const std::string& reason) { lose("the ser
 void SocketcandClientEndpoint::frame_from_server(const can::CanFrame& frame) { bus_.send(bus_id_, frame); }
 
 void SocketcandClientEndpoint::on_frame(const can::CanFrame& frame, uint64_t) {
-  if (!joined() || output_.size() - output_sent_ > kMaxPendingOutputBytes || !session_->send(frame)) {
+  if (!joined() || output_.pending() > kMaxPendingOutputBytes || !session_->send(frame)) {
     ++dropped_frames_;
   }
 }

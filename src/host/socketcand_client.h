@@ -31,6 +31,7 @@
 #include "host/can_bus.h"
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
+#include "host/socket_output.h"
 #include "host/socketcand_protocol.h"
 #include "host/tcp_server.h"
 #include "types/can_frame.h"
@@ -145,8 +146,7 @@ class SocketcandClientEndpoint final : public CanBusEndpoint, private Socketcand
   bool starting_ = true;  // in open(): a failure is returned, not retried
   std::string start_failure_;
   std::unique_ptr<SocketcandClientSession> session_;
-  std::string output_;
-  size_t output_sent_ = 0;
+  SocketOutput output_;
   uint64_t retry_delay_us_ = kFirstRetryUs;
   EventLoop::TimerId retry_timer_ = 0;
   uint64_t dropped_frames_ = 0;

@@ -18,8 +18,6 @@ namespace {
 constexpr uint64_t kAcceptRetryUs = 100'000;
 // How long a full server keeps new clients waiting in the backlog for a slot before it refuses them.
 constexpr uint64_t kRefuseAfterUs = 100'000;
-// Sent output is dropped from the front of the buffer once this much has piled up.
-constexpr size_t kCompactOutputBytes = 64 * 1024;
 
 }  // namespace
 
@@ -71,8 +69,7 @@ void TcpConnection::write(const void* bytes, size_t length) {
     close(server_.config_.overflow_reason);
     return;
   }
-  const auto* first = static_cast<const uint8_t*>(bytes);
-  output_.insert(output_.end(), first, first + length);
+  output_.append(bytes, length);
   flush();
 }
 
@@ -82,26 +79,12 @@ void TcpConnection::hold_output(bool held) {
 }
 
 void TcpConnection::flush() {
-  while (!held_ && output_sent_ < output_.size()) {
-    const ssize_t n =
-        ::send(fd_, output_.data() + output_sent_, output_.size() - output_sent_, MSG_NOSIGNAL | MSG_DONTWAIT);
-    if (n > 0) {
-      output_sent_ += static_cast<size_t>(n);
-    } else if (n < 0 && errno == EINTR) {
-      continue;
-    } else if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
-      break;
-    } else {
-      close(n < 0 ? std::strerror(errno) : "send failed");
+  if (!held_) {
+    std::string error;
+    if (output_.send_to(fd_, &error) == SocketOutput::Sent::kFailed) {
+      close(error);
       return;
     }
-  }
-  if (output_sent_ == output_.size()) {
-    output_.clear();
-    output_sent_ = 0;
-  } else if (output_sent_ > kCompactOutputBytes) {
-    output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(output_sent_));
-    output_sent_ = 0;
   }
   update_events();
   if (!closing_ && output_.empty()) session_->on_output_drained();
@@ -111,7 +94,7 @@ void TcpConnection::update_events() {
   if (closing_) return;
   short events = 0;
   if (session_->read_budget() > 0) events |= POLLIN;
-  if (!held_ && output_sent_ < output_.size()) events |= POLLOUT;
+  if (!held_ && !output_.empty()) events |= POLLOUT;
   server_.loop_.set_events(fd_, events);
 }
 

@@ -15,6 +15,7 @@
 
 #include "host/eeprom_file.h"
 #include "host/event_loop.h"
+#include "host/socket_output.h"
 #include "host/tcp_server.h"
 #include "types/result.h"
 
@@ -60,7 +61,7 @@ class TcpConnection {
   uint64_t id() const { return id_; }
   const std::string& peer() const { return peer_; }
   bool closing() const { return closing_; }
-  size_t pending_output() const { return output_.size() - output_sent_; }
+  size_t pending_output() const { return output_.pending(); }
   // When the loop last saw the socket without input (EventLoop::quiet_seen_us).
   uint64_t quiet_seen_us() const;
   TcpSession& session() { return *session_; }
@@ -86,8 +87,7 @@ class TcpConnection {
   int fd_;
   std::string peer_;
   std::unique_ptr<TcpSession> session_;
-  std::vector<uint8_t> output_;
-  size_t output_sent_ = 0;
+  SocketOutput output_;
   bool held_ = false;
   bool closing_ = false;
 };
