@@ -27,7 +27,6 @@ constexpr int64_t kU8Max = 0xFF;
 constexpr int64_t kU16Max = 0xFFFF;
 constexpr int64_t kU32Max = 0xFFFF'FFFF;
 constexpr uint32_t kCobIdInvalid = 0x8000'0000;  // bit 31: PDO / EMCY not valid
-constexpr uint32_t kCobIdNoRtr = 0x4000'0000;    // bit 30: PDO without RTR; SYNC: generate
 constexpr uint32_t kCobIdExtended = 0x2000'0000; // bit 29: 29-bit identifier
 constexpr uint32_t kCobIdMask = 0x7FF;
 
