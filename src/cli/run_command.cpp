@@ -6,15 +6,18 @@
 // the program is downloaded through the TMCL engine exactly as a host would download it (132,
 // instructions, NOP, 133), started with 129 type 1, and the ticks run back to back without
 // pacing. Samples are direct-mode reads through the engine (GAP, GGP), so they never disturb
-// the program's accumulator.
+// the program's accumulator. With --plot the samples also go into a self-contained HTML page
+// (host/web/trace_page.h).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,10 +31,12 @@
 #include "core/tmcl/engine.h"
 #include "core/tmcl/interpreter.h"
 #include "core/tmcl/status.h"
+#include "host/atomic_file.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
 #include "host/pacing.h"
 #include "host/state_dir.h"
+#include "host/web/trace_page.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
 #include "tools/tmcl_mnemonics.h"
@@ -50,7 +55,8 @@ struct RunOptions {
   std::vector<std::string> include_dirs;
   std::string module;  // default: the first registered module with TMCL
   std::string duration;
-  std::string trace = "trace.csv";
+  std::string trace;  // empty: trace.csv, or none when --plot is given
+  std::string plot;   // the HTML page to write, or empty
   std::string sample = "1ms";
   std::vector<std::string> params;
   std::vector<std::string> variables;
@@ -202,6 +208,32 @@ struct Column {
   tmcl::Instruction read;
 };
 
+// The trace's name for the page's legend and its unit, from the module's parameter listing
+// ("AP52 actual position", "counts").
+void describe_columns(const RunOptions& options, const RunPlan& plan, std::vector<host::web::TraceColumn>& described) {
+  const Result<host::ModuleParameterListing> listing = host::firmware_listing(*plan.descriptor, options.firmware);
+  const auto find = [&listing](host::ParameterKind kind, std::optional<uint8_t> bank,
+                               uint8_t number) -> const host::ListedParameter* {
+    if (!listing) return nullptr;
+    for (const host::ParameterSection& section : listing->sections) {
+      if (section.kind != kind || section.bank != bank) continue;
+      for (const host::ListedParameter& parameter : section.parameters) {
+        if (number >= parameter.first_number && number <= parameter.last_number) return &parameter;
+      }
+    }
+    return nullptr;
+  };
+  for (const uint8_t number : plan.params) {
+    const host::ListedParameter* parameter = find(host::ParameterKind::kAxis, std::nullopt, number);
+    const std::string name = fmt::format("AP{}", number);
+    described.push_back({name, parameter ? name + " " + parameter->name : name, parameter ? parameter->unit : ""});
+  }
+  for (const uint8_t number : plan.variables) {
+    const std::string name = fmt::format("var{}", number);
+    described.push_back({name, fmt::format("{} (user variable {})", name, number), ""});
+  }
+}
+
 // "time_s,AP52,AP42,var0".
 std::string csv_header(const std::vector<Column>& columns) {
   std::string header = "time_s";
@@ -230,27 +262,38 @@ Result<std::vector<Column>> trace_columns(tmcl::TmclEngine& engine, std::string_
   return columns;
 }
 
-// Where the trace goes (--trace FILE, or - for stdout), and the report: stdout, or stderr when
-// stdout carries the trace.
+// Where the trace goes (--trace FILE, or - for stdout, or nowhere: --plot without --trace), and
+// the report: stdout, or stderr when stdout carries the trace.
 class TraceOutput {
  public:
   static Result<TraceOutput> open(const std::string& path) {
     TraceOutput output;
     output.to_stdout_ = path == "-";
-    if (!output.to_stdout_) {
+    output.enabled_ = !path.empty();
+    if (output.enabled_ && !output.to_stdout_) {
       output.file_.open(path, std::ios::trunc);
       if (!output.file_) return Error{fmt::format("cannot write the trace to {}", path)};
     }
     return output;
   }
 
-  std::ostream& trace() { return to_stdout_ ? std::cout : file_; }
+  // nullptr when no CSV is written.
+  std::ostream* trace() { return !enabled_ ? nullptr : to_stdout_ ? &std::cout : &file_; }
   std::ostream& report() { return to_stdout_ ? std::cerr : std::cout; }
   bool to_stdout() const { return to_stdout_; }
+  bool enabled() const { return enabled_; }
 
  private:
   std::ofstream file_;
   bool to_stdout_ = false;
+  bool enabled_ = false;
+};
+
+// --plot: the samples kept for the page, and its file, made before the run so that a path that
+// cannot be written fails at once.
+struct PlotOutput {
+  host::AtomicFile file;
+  host::web::TracePageData page;
 };
 
 // --- Running the program ----------------------------------------------------------------------------
@@ -306,20 +349,26 @@ struct RunSummary {
   double wall_s = 0;
 };
 
-// Runs the ticks back to back and writes a row at the start, after every `ticks.per_sample`
-// and at the end; with `until_stopped` the run ends at the first row after the program stopped.
+// Runs the ticks back to back and takes a sample at the start, after every `ticks.per_sample`
+// and at the end: a CSV row on `trace` and/or a point of `plot` (either may be null); with
+// `until_stopped` the run ends at the first sample after the program stopped.
 RunSummary sample_loop(host::HostRuntime& runtime, tmcl::TmclEngine& engine, const std::vector<Column>& columns,
-                       TickPlan ticks, bool until_stopped, std::ostream& trace) {
+                       TickPlan ticks, bool until_stopped, std::ostream* trace, host::web::TracePageData* plot) {
   const uint64_t start_us = runtime.sim_time_us();
-  trace << csv_header(columns) << '\n';
+  if (trace != nullptr) *trace << csv_header(columns) << '\n';
+  if (plot != nullptr) plot->values.assign(columns.size(), {});
   std::string row;
   const auto sample = [&] {
-    row = format_seconds(runtime.sim_time_us() - start_us);
-    for (const Column& column : columns) {
+    const uint64_t time_us = runtime.sim_time_us() - start_us;
+    row = format_seconds(time_us);
+    if (plot != nullptr) plot->time_s.push_back(static_cast<double>(time_us) / 1e6);
+    for (size_t i = 0; i < columns.size(); ++i) {
+      const int32_t value = engine.execute(columns[i].read, tmcl::Origin::kHost).value;
       row += ',';
-      row += std::to_string(engine.execute(column.read, tmcl::Origin::kHost).value);
+      row += std::to_string(value);
+      if (plot != nullptr) plot->values[i].push_back(value);
     }
-    trace << row << '\n';
+    if (trace != nullptr) *trace << row << '\n';
   };
   const auto running = [&] {
     const auto status = engine.device().runtime().application_status;
@@ -343,7 +392,7 @@ RunSummary sample_loop(host::HostRuntime& runtime, tmcl::TmclEngine& engine, con
       if (until_stopped) break;
     }
   }
-  trace.flush();
+  if (trace != nullptr) trace->flush();
   summary.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   summary.simulated_us = runtime.sim_time_us() - start_us;
   summary.instructions = engine.interpreter().instructions_executed() - instructions_before;
@@ -352,14 +401,20 @@ RunSummary sample_loop(host::HostRuntime& runtime, tmcl::TmclEngine& engine, con
 
 // The report after the run; the exit status says whether the program stopped on a fault.
 int report_run(const RunOptions& options, std::string_view module_name, tmcl::TmclEngine& engine,
-               const std::vector<Column>& columns, const RunSummary& summary, TraceOutput& output) {
-  std::ostream& report = output.report();
+               const std::vector<Column>& columns, const RunSummary& summary, const TraceOutput& output,
+               std::ostream& report) {
   report << fmt::format("{}: {} s of simulated time on {} in {:.3f} s ({:.1f}x real time), {} instructions\n",
                         options.program, format_seconds(summary.simulated_us), module_name, summary.wall_s,
                         summary.wall_s > 0 ? static_cast<double>(summary.simulated_us) * 1e-6 / summary.wall_s : 0.0,
                         summary.instructions);
-  report << fmt::format("trace: {} samples ({}) every {} to {}\n", summary.samples, csv_header(columns), options.sample,
-                        output.to_stdout() ? "stdout" : options.trace);
+  if (output.enabled()) {
+    report << fmt::format("trace: {} samples ({}) every {} to {}\n", summary.samples, csv_header(columns),
+                          options.sample, output.to_stdout() ? "stdout" : options.trace);
+  }
+  if (!options.plot.empty()) {
+    report << fmt::format("plot: {} samples ({}) every {} to {}\n", summary.samples, csv_header(columns),
+                          options.sample, options.plot);
+  }
   const tmcl::StopReason reason = engine.interpreter().stop_reason();
   if (!summary.stopped_at_us) {
     report << fmt::format("program: still running at the end (program counter {})\n",
@@ -370,6 +425,36 @@ int report_run(const RunOptions& options, std::string_view module_name, tmcl::Tm
                         format_seconds(*summary.stopped_at_us), tmcl::stop_reason_text(reason),
                         engine.interpreter().stop_address());
   return is_fault(reason) ? kExitProgramFault : kExitSuccess;
+}
+
+// "2026-11-27 02:40:13 UTC".
+std::string utc_now() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%d %H:%M:%S UTC", &utc);
+  return text;
+}
+
+// The page's file (made now) and what it says about the run; the samples come later.
+Result<PlotOutput> open_plot(const RunOptions& options, const RunPlan& plan, const host::VirtualModule& module) {
+  Result<host::AtomicFile> file = host::AtomicFile::create(options.plot);
+  if (!file) return Error{file.error()}.with_context("--plot: ");
+  PlotOutput plot{std::move(*file), {}};
+  host::web::TracePageData& page = plot.page;
+  const Result<const host::FirmwareGeneration*> generation = host::find_firmware(*plan.descriptor, options.firmware);
+  page.module = module.name();
+  page.firmware = generation && *generation != nullptr ? std::string((*generation)->version)
+                                                       : std::string(plan.descriptor->firmware);
+  page.program = options.program;
+  page.started_utc = utc_now();
+  page.sample_s = static_cast<double>(plan.sample_us) / 1e6;
+  const size_t slash = options.program.find_last_of('/');
+  page.title = fmt::format("{} on {}, {}", slash == std::string::npos ? options.program : options.program.substr(slash + 1),
+                           page.module, page.started_utc);
+  describe_columns(options, plan, page.columns);
+  return plot;
 }
 
 int run_run(const RunOptions& options) {
@@ -393,8 +478,16 @@ int run_run(const RunOptions& options) {
   tmcl::TmclEngine& engine = module.engine();
   const Result<std::vector<Column>> columns = trace_columns(engine, module.name(), *plan, options.motor);
   if (!columns) return usage_error(columns.error());
-  Result<TraceOutput> output = TraceOutput::open(options.trace);
+  // No CSV unless asked for when the page is the output.
+  Result<TraceOutput> output =
+      TraceOutput::open(!options.trace.empty() ? options.trace : options.plot.empty() ? "trace.csv" : "");
   if (!output) return usage_error(output.error());
+  std::optional<PlotOutput> plot;
+  if (!options.plot.empty()) {
+    Result<PlotOutput> opened = open_plot(options, *plan, module);
+    if (!opened) return usage_error(opened.error());
+    plot.emplace(std::move(*opened));
+  }
 
   if (const Result<void> downloaded = download(engine, program->instructions); !downloaded) {
     return usage_error(downloaded.error());
@@ -407,8 +500,21 @@ int run_run(const RunOptions& options) {
   });
   runtime.start();
   if (const Result<void> started = start_program(engine, *address); !started) return usage_error(started.error());
-  const RunSummary summary = sample_loop(runtime, engine, *columns, *ticks, options.until_stopped, output->trace());
-  return report_run(options, module.name(), engine, *columns, summary, *output);
+  const RunSummary summary = sample_loop(runtime, engine, *columns, *ticks, options.until_stopped, output->trace(),
+                                         plot ? &plot->page : nullptr);
+  std::ostringstream report_text;
+  const int status = report_run(options, module.name(), engine, *columns, summary, *output, report_text);
+  report << report_text.str();
+  if (plot) {
+    plot->page.duration_s = static_cast<double>(summary.simulated_us) / 1e6;
+    plot->page.report = report_text.str();
+    const Result<std::string> page = host::web::render_trace_page(plot->page);
+    if (!page) return usage_error(page.error());
+    if (const Result<void> written = plot->file.commit(*page); !written) {
+      return usage_error(Error{written.error()}.with_context("--plot: ").message);
+    }
+  }
+  return status;
 }
 
 }  // namespace
@@ -436,7 +542,12 @@ void add_run_command(CLI::App& app, int& exit_status) {
   command->add_option("--for", options->duration, "Simulated time to run: 10s, 500ms, 2.5s, 1min")
       ->type_name("DURATION")
       ->required();
-  command->add_option("--trace", options->trace, "The CSV file to write, - for stdout")->capture_default_str();
+  command->add_option("--trace", options->trace,
+                      "The CSV file to write, - for stdout (default trace.csv; none when --plot is given alone)")
+      ->type_name("FILE");
+  command->add_option("--plot", options->plot,
+                      "Also write the trace as a self-contained HTML page with its curves (opens offline)")
+      ->type_name("FILE.html");
   command->add_option("--sample", options->sample, "Sample period in simulated time (a multiple of the control tick)")
       ->type_name("DURATION")
       ->capture_default_str();
@@ -470,12 +581,15 @@ void add_run_command(CLI::App& app, int& exit_status) {
       "  motwin run program.tmc --for 10s --trace trace.csv\n"
       "  motwin run program.tmc --for 2s --sample 10ms --param 52,42,55 --var 0 --trace - | head\n"
       "  motwin run jumps.tmc --label Func3 --for 8s --until-stopped --trace func3.csv\n"
+      "  motwin run step.tmc --for 1s --param 52,42,13 --plot step.html\n"
       "\n"
       "The program is downloaded (132 ... 133) and started with 129 type 1 at address 0 (or --address,\n"
       "--label); then the simulation runs without pacing for --for of simulated time. The CSV has a\n"
       "header 'time_s,AP52,AP42,var0' and one row per sample (at 0, every --sample, and at the end),\n"
       "time in simulated seconds from the start of the program. A program that stops before --for\n"
       "keeps being sampled until --for (motion continues), unless --until-stopped.\n"
+      "--plot writes the same samples as one HTML page (curves, zoom, cursor, trigger, CSV and PNG\n"
+      "export; nothing loaded from the network); see docs/web-console.md.\n"
       "Exit status: 0 done, 1 the program has errors or stopped on a fault (jump outside memory,\n"
       "invalid instruction ...), 2 usage error or unreadable file. See docs/tmcl-programs.md.\n");
   command->callback([options, &exit_status] { exit_status = run_run(*options); });
