@@ -439,6 +439,7 @@ std::string utc_now() {
 
 // The page's file (made now) and what it says about the run; the samples come later.
 Result<PlotOutput> open_plot(const RunOptions& options, const RunPlan& plan, const host::VirtualModule& module) {
+  if (options.plot == "-") return Error{"--plot -: the page goes to a file (--plot FILE.html); --trace - prints the CSV"};
   Result<host::AtomicFile> file = host::AtomicFile::create(options.plot);
   if (!file) return Error{file.error()}.with_context("--plot: ");
   PlotOutput plot{std::move(*file), {}};

@@ -389,6 +389,21 @@ def test_scope_keeps_up_live(motwin):
         check_equal(browser.js("const u = window.liveScope.scope.uplot; return [u.scales.x.min, u.scales.x.max];"),
                     frozen, "a single-shot capture stays after more pushes")
         check(decode_png(browser.js("return window.liveScope.scope.exportPng();"))[0] > 0, "PNG of the live scope")
+
+        # Normal mode: re-armed after each capture, the view moves on to the next completed one
+        # (the sine falls through 0.5 once a second).
+        start = LIVE_PUSHES + 112
+        browser.js("window.liveScope.scope.setTrigger({series: 0, level: 0.5, edge: 'falling', mode: 'normal',"
+                   " windowSeconds: 0.4});"
+                   "for (let n = arguments[0]; n < arguments[0] + 60; n++) {"
+                   "  const [t, v] = window.liveScope.sample(n); window.liveScope.scope.push(t, v); }", start)
+        first = browser.js("return window.liveScope.scope.triggerStatus();")
+        browser.js("for (let n = arguments[0]; n < arguments[0] + 25; n++) {"
+                   "  const [t, v] = window.liveScope.sample(n); window.liveScope.scope.push(t, v); }", start + 60)
+        second = browser.js("return window.liveScope.scope.triggerStatus();")
+        check(first["state"] == "armed" and second["state"] == "armed", f"normal mode re-arms: {first}, {second}")
+        check(abs(second["time_s"] - first["time_s"] - 1.0) < 1e-9,
+              f"the next capture one sine period later: {first['time_s']} -> {second['time_s']}")
         severe = browser.severe_log_entries()
         check_equal(severe, [], "SEVERE entries in the browser log")
 

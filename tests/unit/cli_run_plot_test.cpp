@@ -173,6 +173,10 @@ TEST(CliRunPlot, a_path_that_cannot_be_written_is_a_usage_error_before_the_run) 
   EXPECT_TRUE(contains(directory_run.output, "--plot: cannot write " + directory.path().string() + ": Is a directory"))
       << directory_run.output;
   EXPECT_TRUE(std::filesystem::is_empty(directory.path()));
+
+  const tools::CompletedProcess to_stdout = run_motwin({"run", kStepProgram, "--for", "1s", "--plot", "-"});
+  EXPECT_EQ(to_stdout.exit_status, 2) << to_stdout.output;
+  EXPECT_TRUE(contains(to_stdout.output, "motwin: error: --plot -: the page goes to a file")) << to_stdout.output;
 }
 
 }  // namespace

@@ -505,9 +505,8 @@
       this.zoomRange = null;
       // Normal mode shows this capture until the next one completes.
       this.triggerState = this.trigger.mode === "normal" ? "armed" : "triggered";
-      if (this.trigger.mode === "normal") this.lastCaptureTime = trigger_s;
       this.updateStatus();
-      this.redraw();
+      if (!this.paused) this.redraw();
     }
 
     // On loaded data: the first crossing, shown with its pre-trigger part.
