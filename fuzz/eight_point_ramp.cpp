@@ -29,6 +29,16 @@
 
 namespace {
 
+// Tick budgets of one input (fuzz/README.md, Decisions): the random phase runs at most
+// kRandomPhaseTicks, at most kTicksPerOperation after each operation; the final stop and move
+// are skipped when their bound exceeds kStopBoundTicks / kMoveBoundTicks, and the final move's
+// distance is drawn so that it fits kMoveBudgetTicks at the profile's speeds.
+constexpr int kRandomPhaseTicks = 4'000;
+constexpr int kTicksPerOperation = 300;
+constexpr double kStopBoundTicks = 60'000;  // TZEROWAIT's longest (2.1 s) at 50 µs fits
+constexpr double kMoveBudgetTicks = 20'000;
+constexpr double kMoveBoundTicks = 2 * kMoveBudgetTicks;
+
 using motwin::motion::EightPointConfig;
 using motwin::motion::EightPointConfigError;
 using motwin::motion::EightPointRamp;
@@ -77,8 +87,14 @@ EightPointConfig random_config(FuzzedDataProvider& in) {
       if (*r == 0.0) *r = 1e5;
     }
   }
-  // 2015 is 16 bits of 32 µs; TVMAX has no object (0) but the class takes any.
-  c.tzerowait_us = in.ConsumeBool() ? 0u : 32u * in.ConsumeIntegral<uint16_t>();
+  // 2015 is 16 bits of 32 µs (up to 2.1 s, 42 000 ticks of 50 µs: mostly shorter, as every
+  // reversal and stop rests it out within the tick budget); TVMAX has no object (0) but the
+  // class takes any.
+  switch (in.ConsumeIntegralInRange<int>(0, 7)) {
+    case 0: case 1: case 2: case 3: c.tzerowait_us = 0; break;
+    case 7: c.tzerowait_us = 32u * in.ConsumeIntegral<uint16_t>(); break;
+    default: c.tzerowait_us = 32u * in.ConsumeIntegral<uint8_t>(); break;
+  }
   c.tvmax_us = in.ConsumeIntegralInRange<int>(0, 3) == 0 ? in.ConsumeIntegralInRange<uint32_t>(0, 100'000) : 0u;
   if (in.ConsumeIntegralInRange<int>(0, 31) == 0) {  // what a broken caller might pass
     double* values[] = {&c.vstart_pps, &c.a1_pps2, &c.v1_pps, &c.a2_pps2, &c.v2_pps, &c.vmax_pps,
@@ -123,6 +139,11 @@ struct Checker {
   EightPointRamp& ramp;
   double previous_velocity = 0.0;  // of the last tick (or as halt()/set_state() left it)
   double stop_rate_pps2 = 0.0;  // the deceleration given to the last stop()
+  // steepest_rate() of the profile: set by use() wherever the input changes the profile (the
+  // only places it changes), not recomputed every tick.
+  double steepest_pps2 = 0.0;
+
+  void use(const EightPointConfig& c) { steepest_pps2 = steepest_rate(c); }
 
   void tick(const EightPointConfig& c, double dt_s) {
     const Mode mode = ramp.mode();
@@ -140,7 +161,7 @@ struct Checker {
     if (mode == Mode::kStop) FUZZ_CHECK(now <= before + tolerance, "a stop speeds up: %.17g -> %.17g", before, now);
     FUZZ_CHECK(!(previous_velocity > 0.0 && v < 0.0) && !(previous_velocity < 0.0 && v > 0.0),
                "direction flipped without rest: %.17g -> %.17g", previous_velocity, v);
-    const double steepest = std::fmax(steepest_rate(c), stop_rate_pps2);
+    const double steepest = std::fmax(steepest_pps2, stop_rate_pps2);
     const double one_tick = steepest * dt_s * (1.0 + 1e-6) + 1e-6 * (1.0 + before);
     if (previous_velocity != 0.0 && v != 0.0) {
       FUZZ_CHECK(std::fabs(v - previous_velocity) <= one_tick, "velocity %.17g -> %.17g in one tick (steepest %g)",
@@ -167,8 +188,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
 
   EightPointRamp ramp;
   Checker checker{ramp};
+  checker.use(config);
   uint32_t longest_tzerowait_us = config.tzerowait_us;  // a wait under way keeps its length
-  int ticks_left = 60'000;  // for the random phase; the final move has its own bound
+  int ticks_left = kRandomPhaseTicks;  // the final move has its own bound
   for (int op = 0; op < 24 && in.remaining_bytes() > 0 && ticks_left > 0; ++op) {
     switch (in.ConsumeIntegralInRange<int>(0, 9)) {
       case 0:
@@ -196,6 +218,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         check_refusal(next, next_error);
         if (next_error == EightPointConfigError::kNone) {
           config = next;
+          checker.use(config);
           longest_tzerowait_us = std::max(longest_tzerowait_us, next.tzerowait_us);
         }
         break;
@@ -210,7 +233,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       default:
         break;
     }
-    const int ticks = in.ConsumeIntegralInRange<int>(0, 4000);
+    const int ticks = in.ConsumeIntegralInRange<int>(0, kTicksPerOperation);
     for (int i = 0; i < ticks && ticks_left > 0; ++i, --ticks_left) checker.tick(config, dt_s);
   }
 
@@ -226,7 +249,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   {
     const double speed_now = std::fabs(ramp.velocity());
     const double stop_bound_s = 2.0 * speed_now / d_min + tzerowait_s + 20 * dt_s;
-    if (stop_bound_s / dt_s > 400'000) return 0;  // beyond the budget of one input
+    if (stop_bound_s / dt_s > kStopBoundTicks) return 0;  // beyond the budget of one input
     const long bound = static_cast<long>(stop_bound_s / dt_s) + 2;
     long i = 0;
     for (; i < bound && (!ramp.standstill() || ramp.waiting()); ++i) checker.tick(config, dt_s);
@@ -250,7 +273,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   }
   // A distance the tick budget can drive at the profile's speeds.
   const double fixed_s = config.vmax_pps / a_min + config.vmax_pps / d_min + tvmax_s;
-  const double budget_s = 300'000 * dt_s;
+  const double budget_s = kMoveBudgetTicks * dt_s;
   if (fixed_s > budget_s) return 0;
   const double reachable = std::fmin(2e9, (budget_s - fixed_s) * config.vmax_pps * 0.5);
   const int64_t distance = static_cast<int64_t>(in.ConsumeFloatingPointInRange<double>(-1.0, 1.0) * reachable);
@@ -261,7 +284,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // even for that).
   const double move_s =
       1.5 * (std::fabs(ramp.distance_to_target()) / config.vmax_pps + fixed_s) + 2.0 * tvmax_s + 20 * dt_s;
-  if (move_s / dt_s > 600'000) return 0;  // beyond the budget of one input
+  if (move_s / dt_s > kMoveBoundTicks) return 0;  // beyond the budget of one input
   const long bound = static_cast<long>(move_s / dt_s) + 2;
   long i = 0;
   for (; i < bound && !ramp.position_reached(); ++i) {
