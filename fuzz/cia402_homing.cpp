@@ -149,35 +149,35 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (in.ConsumeIntegralInRange<int>(0, 15) == 0) config.slow_speed_pps = 0;
   const double max_speed = std::fmax(config.fast_speed_pps, config.slow_speed_pps);
   const double min_speed = std::fmax(1.0, std::fmin(config.fast_speed_pps, config.slow_speed_pps));
-  // Ramps of at most ~2000 ticks and braking distances of at most ~4000 ticks at the lower
-  // speed: the run stays within the tick budget.
+  // Ramps of at most ~500 ticks and braking distances of at most ~1000 ticks at the lower
+  // speed: the run stays within a tick budget of a few thousand (fuzz/README.md, Decisions).
   const double min_acceleration =
-      std::fmax(1.0, std::fmax(max_speed / (2000 * dt_s), max_speed * max_speed / (2.0 * min_speed * 4000 * dt_s)));
+      std::fmax(1.0, std::fmax(max_speed / (500 * dt_s), max_speed * max_speed / (2.0 * min_speed * 1000 * dt_s)));
   config.acceleration_pps2 = static_cast<int32_t>(
       std::fmin(2e9, min_acceleration * in.ConsumeFloatingPointInRange<double>(1.0, in.ConsumeBool() ? 4.0 : 1000.0)));
   config.home_offset_usteps = in.ConsumeIntegral<int32_t>();
 
-  // Lengths in units of one tick at the lower speed: every crossing takes at most a few thousand ticks.
+  // Lengths in units of one tick at the lower speed: every crossing takes at most about a thousand ticks.
   const int64_t unit = static_cast<int64_t>(std::ceil(min_speed * dt_s));
   const auto length = [&](int64_t lo, int64_t hi) { return unit * in.ConsumeIntegralInRange<int64_t>(lo, hi); };
   Machine m;
   m.left_present = in.ConsumeIntegralInRange<int>(0, 7) != 0;
   m.right_present = in.ConsumeIntegralInRange<int>(0, 7) != 0;
-  m.left_at = -length(0, 2000);
-  m.right_at = m.left_at + length(1, 4000);
+  m.left_at = -length(0, 500);
+  m.right_at = m.left_at + length(1, 1000);
   m.cam_present = in.ConsumeIntegralInRange<int>(0, 7) != 0;
-  m.cam_from = m.left_at + length(-200, 4200);
-  m.cam_to = m.cam_from + (in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(0, 3 * unit) : length(0, 1000));
+  m.cam_from = m.left_at + length(-50, 1050);
+  m.cam_to = m.cam_from + (in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(0, 3 * unit) : length(0, 250));
   m.encoder = in.ConsumeIntegralInRange<int>(0, 15) != 0;
   m.pulses = in.ConsumeIntegralInRange<int>(0, 15) != 0;
-  m.pitch = in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(1, 4 * unit) : length(1, 1000);
+  m.pitch = in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(1, 4 * unit) : length(1, 250);
   m.phase = in.ConsumeIntegralInRange<int64_t>(0, m.pitch - 1);
-  int64_t start = m.left_at + length(-300, 4300);
+  int64_t start = m.left_at + length(-75, 1075);
   const int32_t counter_start = in.ConsumeIntegral<int32_t>();
   if (in.ConsumeIntegralInRange<int>(0, 3) == 0 || !m.left_present || !m.right_present) {
-    config.search_limit_usteps = static_cast<uint32_t>(length(1, 12000));
+    config.search_limit_usteps = static_cast<uint32_t>(length(1, 3000));
   }
-  if (in.ConsumeIntegralInRange<int>(0, 3) == 0) config.index_search_limit_usteps = static_cast<uint32_t>(length(1, 3000));
+  if (in.ConsumeIntegralInRange<int>(0, 3) == 0) config.index_search_limit_usteps = static_cast<uint32_t>(length(1, 750));
 
   // Braking from either speed; room to brake and a tick of travel on both sides of a switch.
   const double brake = max_speed * max_speed / (2.0 * config.acceleration_pps2);
@@ -188,9 +188,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     m.left_present = m.right_present = m.cam_present = m.encoder = m.pulses = true;
     config.search_limit_usteps = config.index_search_limit_usteps = 0;
     const int64_t room = margin + m.pitch + 1;
-    m.cam_from = m.left_at + room + length(0, 500);
-    m.cam_to = m.cam_from + static_cast<int64_t>(4.0 * max_speed * dt_s) + 3 + length(0, 500);
-    m.right_at = m.cam_to + room + length(0, 500);
+    m.cam_from = m.left_at + room + length(0, 125);
+    m.cam_to = m.cam_from + static_cast<int64_t>(4.0 * max_speed * dt_s) + 3 + length(0, 125);
+    m.right_at = m.cam_to + room + length(0, 125);
     start = m.left_at + room + in.ConsumeIntegralInRange<int64_t>(0, m.right_at - m.left_at - 2 * room);
   }
 
@@ -239,7 +239,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   int64_t done_at = 0;
   long tick = 0;
   // Sometimes the master ends the homing early (controlword bit 4 falls, halt, quick stop).
-  const long stop_at_tick = in.ConsumeIntegralInRange<int>(0, 3) == 0 ? in.ConsumeIntegralInRange<long>(0, 5000) : -1;
+  const long stop_at_tick = in.ConsumeIntegralInRange<int>(0, 3) == 0 ? in.ConsumeIntegralInRange<long>(0, 1250) : -1;
   bool stopped = false;
   for (; tick < bound_ticks; ++tick) {
     const HomingInputs inputs = axis.sense();
