@@ -40,10 +40,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   auto rig = fuzz::fresh_rig<Rig>();
   tmcl::TmclEngine& engine = rig->engine();
-  int ticks_left = 20'000;  // 1 s of motion per input at most
+  // 50 ms of motion per input at most, in batches of up to 5 ms (fuzz/README.md, Decisions).
+  int ticks_left = 1'000;
   for (int step = 0; step < 256 && in.remaining_bytes() > 0; ++step) {
     if (in.ConsumeIntegralInRange<int>(0, 5) == 0) {
-      const int ticks = in.ConsumeIntegralInRange<int>(1, 2000);
+      const int ticks = in.ConsumeIntegralInRange<int>(1, 100);
       for (int t = 0; t < ticks && ticks_left > 0; ++t, --ticks_left) rig->tick();
       fuzz::check_parameter_ranges(*rig->module, "after ticks");
       check_motor(*rig);
