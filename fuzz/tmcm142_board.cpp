@@ -19,6 +19,7 @@
 //   count the firmware sees as the sensors compute it from the rotor position (unless the
 //   encoder is faulty or an input changed in that tick), every writable axis parameter inside
 //   its row's range.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -94,6 +95,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                  events.size(), parsed.error().c_str());
   }
   const size_t event_count = events.size();
+  // The run lasts until 20 ms after the last event (at least 20 ms, at most 100 ms): every event
+  // of the first 100 ms is applied on time and has 20 ms of firmware after it, and an input
+  // without events costs a fifth of the 100 ms (fuzz/README.md, Decisions).
+  constexpr uint64_t kShortestRunUs = 20'000;
+  constexpr uint64_t kLongestRunUs = 100'000;
+  const uint64_t last_event_us = events.empty() ? 0 : events.back().time_us;
+  const uint64_t run_us = std::min(std::min(last_event_us, kLongestRunUs) + kShortestRunUs, kLongestRunUs);
 
   // As Tmcm142VirtualModule::make and run_ticks wire them.
   auto io = std::make_unique<sim::Tmcm142SimIo>();
@@ -125,10 +133,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     default: break;  // standing still, powered
   }
 
-  constexpr uint32_t kTicks = 100 * modules::tmcm142::kTicksPerMillisecond;
+  const auto ticks = static_cast<uint32_t>(run_us / modules::tmcm142::kControlTickUs);
   // Only an input (a scenario event) sets ENCODER_FAULT: read again when inputs changed.
   bool encoder_fault = board->read_signal("ENCODER_FAULT") != 0.0;
-  for (uint32_t tick = 0; tick < kTicks; ++tick) {
+  double previous_position_rev = board->rotor_revolutions();
+  for (uint32_t tick = 0; tick < ticks; ++tick) {
     const uint64_t now_us = uint64_t{tick} * modules::tmcm142::kControlTickUs;
     io->set_sim_time_us(now_us);
     const bool inputs_changed = player.apply_due(now_us) != 0;
@@ -144,11 +153,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     board->after_tick(modules::tmcm142::kControlTickS);
     // The readings POSITION_REV, SPEED_RPM, COIL_A_A, COIL_B_A and TORQUE_NM, from the accessors
     // read_signal() answers them with (looking five names up per tick cost three quarters of
-    // each input's time); the ideal motor's speed has no accessor.
+    // each input's time). The ideal motor's speed has no accessor: it is its tick's whole-number
+    // electrical angle step over the tick (IdealStepper::advance), the same as the position's
+    // change over the tick, which is checked every tick; SPEED_RPM itself with the ranges.
     const sim::StepperPlant* plant = board->plant();
+    const double position_rev = board->rotor_revolutions();
     const double readings[] = {
-        board->rotor_revolutions(),
-        plant ? plant->velocity_rps() : board->read_signal("SPEED_RPM").value_or(0.0),
+        position_rev,
+        plant ? plant->velocity_rps() : (position_rev - previous_position_rev) / modules::tmcm142::kControlTickS,
         plant ? plant->coil_a_current_a() : 0.0,
         plant ? plant->coil_b_current_a() : 0.0,
         plant ? plant->motor_torque_nm() : 0.0};
@@ -156,7 +168,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (size_t i = 0; i < std::size(readings); ++i) {
       FUZZ_CHECK(std::isfinite(readings[i]), "%s is %g after tick %u", kReadingNames[i], readings[i], tick);
     }
-    if (tick % 500 == 499) fuzz::check_axis_parameter_ranges(*module, "while running");
+    previous_position_rev = position_rev;
+    if (tick % 200 == 199 || tick + 1 == ticks) {
+      fuzz::check_axis_parameter_ranges(*module, "while running");
+      const double speed_rpm = board->read_signal("SPEED_RPM").value_or(0.0);
+      FUZZ_CHECK(std::isfinite(speed_rpm), "SPEED_RPM is %g after tick %u", speed_rpm, tick);
+    }
   }
   const size_t applied_on_time = player.applied_count();
   const size_t applied_late = player.apply_due(UINT64_MAX);
