@@ -14,11 +14,12 @@
 // - a scenario that parses gives events sorted by time (file order among equal times), each on a
 //   signal of the TMCM-142 table in its canonical spelling with a value it accepts, a time
 //   within bounds and a line inside the text; errors name the source and line;
-// - 100 ms of firmware and board with the events applied as their times come (and all of them
-//   at the end): every reading finite (position, speed, coil currents, torque), the encoder
-//   count the firmware sees as the sensors compute it from the rotor position (unless the
-//   encoder is faulty or an input changed in that tick), every writable axis parameter inside
-//   its row's range.
+// - firmware and board until 20 ms after the last event (20 to 100 ms) with the events applied as
+//   their times come (and all of them at the end): every reading finite (position, speed, coil
+//   currents, torque; the ideal motor's speed from its position change, SPEED_RPM with the
+//   range checks), the encoder count the firmware sees as the sensors compute it from the rotor
+//   position (unless the encoder is faulty or an input changed in that tick), every writable
+//   axis parameter inside its row's range (every 10 ms and at the end).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
