@@ -10,6 +10,7 @@
 //   endpoint can-slcan-pty <LINK> </dev/pts/N>     one per --can slcan:LINK
 //   endpoint can-socketcan <IFACE>                 one per --can socketcan:IFACE
 //   endpoint can-socketcand-client <HOST:PORT> <CHANNEL>  one per --can socketcand-client:...
+//   endpoint web <HOST:PORT>                       for --web (the console's page and WebSocket)
 // With --node (several modules on one bus) the first line is one line per node instead:
 //   motwin: node <name> <module> (<firmware>) eeprom <path|none>
 //   ready
@@ -48,8 +49,10 @@
 #include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
+#include "host/web/web_server.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
+#include "tools/web/web_console.h"
 #include "types/result.h"
 
 namespace motwin::cli {
@@ -63,6 +66,8 @@ struct ServeArguments {
   std::vector<std::string> tcp_endpoints;
   std::string pty_link;
   std::vector<std::string> can_endpoints;
+  std::string web_endpoint;
+  std::string web_token;
   int node_id = 0;
   std::string can_capture;
   std::string state_dir;
@@ -165,6 +170,7 @@ struct EndpointPlan {
   uint32_t can_bit_rate = 0;
   std::string can_capture;  // a file; empty: none
   double can_stats_s = 0;   // 0: no can-stats lines
+  std::optional<host::web::WebEndpointSpec> web;  // --web
 };
 
 struct ServePlan {
@@ -305,6 +311,13 @@ Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, c
   if (plan.can.empty() && arguments.can_stats_s > 0) return Error{"--can-stats needs a CAN bus (--can)"};
   plan.can_capture = arguments.can_capture;
   plan.can_stats_s = arguments.can_stats_s;
+  if (!arguments.web_endpoint.empty()) {
+    Result<host::web::WebEndpointSpec> web = host::web::parse_web_endpoint(arguments.web_endpoint, arguments.web_token);
+    if (!web) return web.error_with_context("--web: ");
+    plan.web = std::move(*web);
+  } else if (!arguments.web_token.empty()) {
+    return Error{"--web-token needs --web"};
+  }
   return plan;
 }
 
@@ -462,11 +475,60 @@ Result<std::vector<OpenEndpoint>> open_tmcl_endpoints(host::HostRuntime& runtime
   return endpoints;
 }
 
+// The web console (--web): what it reaches, then its server. The console goes after the server.
+struct WebEndpoint {
+  std::unique_ptr<tools::web::WebConsole> console;
+  std::unique_ptr<host::web::WebServer> server;
+  ~WebEndpoint() { server.reset(); }
+};
+std::string where(const WebEndpoint& web) { return web.server->local_address(); }
+
+// A CANopen node's ID as serve set it: its option, or the stored default (1).
+uint8_t configured_node_id(uint8_t node_id) { return node_id != 0 ? node_id : 1; }
+
+Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus& can, const ServedModule& served,
+                                       const ModulePlan& module, const EndpointPlan& plan) {
+  std::vector<tools::web::ConsoleTarget> targets;
+  host::CanBus* bus = plan.can.empty() ? nullptr : &can.bus();
+  if (served.group == nullptr) {
+    const host::VirtualModule& single = *served.module;
+    if (runtime.has_tmcl_service()) {
+      targets.push_back(tools::web::tmcl_target(*module.descriptor, std::string(single.name()),
+                                                std::string(single.firmware_version()), module.options.firmware,
+                                                &runtime.service()));
+    } else {
+      targets.push_back(tools::web::canopen_target(*module.descriptor, std::string(single.name()),
+                                                   std::string(single.firmware_version()),
+                                                   configured_node_id(module.options.node_id)));
+    }
+  } else {
+    for (size_t i = 0; i < module.nodes.size(); ++i) {
+      const host::NodeSpec& spec = module.nodes[i];
+      const host::ModuleGroup::Member& member = served.group->members()[i];
+      const host::ModuleDescriptor& descriptor = *host::find_module(spec.module);
+      const std::string firmware(member.module->firmware_version());
+      targets.push_back(descriptor.canopen != nullptr
+                            ? tools::web::canopen_target(descriptor, member.name, firmware,
+                                                         configured_node_id(spec.node_id))
+                            : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware, nullptr));
+    }
+  }
+  auto web = std::make_unique<WebEndpoint>();
+  web->console = std::make_unique<tools::web::WebConsole>(
+      runtime.loop(), [&runtime] { return runtime.sim_time_us(); }, std::move(targets), bus);
+  tools::web::WebConsole& console = *web->console;
+  Result<std::unique_ptr<host::web::WebServer>> server = host::web::WebServer::open(
+      runtime.loop(), *plan.web, [&console](host::web::WebConnection& connection) { return console.open_session(connection); });
+  if (!server) return server.error_with_context("--web: ");
+  web->server = std::move(*server);
+  return keep_open(Result<std::unique_ptr<WebEndpoint>>(std::move(web)), "web", "");
+}
+
 // The endpoints of the plan in the order of their lines: TMCL over TCP and on a pty, then, once
 // the modules are on the bus and its capture runs, the CAN endpoints. On a failure the ones
 // already open close again.
-Result<std::vector<OpenEndpoint>> open_endpoints(host::HostRuntime& runtime, ServedCanBus& can,
-                                                 const ServedModule& served, const EndpointPlan& plan) {
+Result<std::vector<OpenEndpoint>> open_can_and_tmcl_endpoints(host::HostRuntime& runtime, ServedCanBus& can,
+                                                              const ServedModule& served, const EndpointPlan& plan) {
   Result<std::vector<OpenEndpoint>> endpoints = open_tmcl_endpoints(runtime, plan);
   if (!endpoints || plan.can.empty()) return endpoints;
   can.join(served.bus_nodes());
@@ -478,6 +540,18 @@ Result<std::vector<OpenEndpoint>> open_endpoints(host::HostRuntime& runtime, Ser
     if (!opened) return Error{opened.error()};
     endpoints->push_back(std::move(*opened));
   }
+  return endpoints;
+}
+
+// Then the web console, which reaches the modules through the TMCL service and the bus.
+Result<std::vector<OpenEndpoint>> open_endpoints(host::HostRuntime& runtime, ServedCanBus& can,
+                                                 const ServedModule& served, const ModulePlan& module,
+                                                 const EndpointPlan& plan) {
+  Result<std::vector<OpenEndpoint>> endpoints = open_can_and_tmcl_endpoints(runtime, can, served, plan);
+  if (!endpoints || !plan.web) return endpoints;
+  Result<OpenEndpoint> web = open_web_endpoint(runtime, can, served, module, plan);
+  if (!web) return Error{web.error()};
+  endpoints->push_back(std::move(*web));
   return endpoints;
 }
 
@@ -579,7 +653,7 @@ int run_serve(const ServeArguments& arguments) {
   if (plan->module.scenario) runtime.set_scenario(std::move(*plan->module.scenario));
   ServedCanBus can(module, plan->endpoints.can_bit_rate);
   // After the runtime and the bus: the endpoints close before them.
-  Result<std::vector<OpenEndpoint>> endpoints = open_endpoints(runtime, can, *served, plan->endpoints);
+  Result<std::vector<OpenEndpoint>> endpoints = open_endpoints(runtime, can, *served, plan->module, plan->endpoints);
   if (!endpoints) return usage_error(endpoints.error());
   const std::vector<Report> reports = start_reports(runtime, can, plan->endpoints.can_stats_s);
   stop_on_shutdown_signals(runtime, shutdown_signals);
@@ -720,6 +794,16 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("socketcand:HOST:PORT|slcan-tcp:HOST:PORT|slcan:LINK|socketcan:IFACE|socketcand-client:HOST:PORT:CHANNEL")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  serve->add_option("--web", arguments->web_endpoint,
+                    "Serve the web console on HOST:PORT (HTTP and WebSocket; open http://HOST:PORT/ in a browser): "
+                    "the parameters or objects of every module, a direct-mode console, and a JSON protocol that "
+                    "scripts speak too (docs/web-console.md). Port 0 picks a free port. A HOST other than loopback "
+                    "needs --web-token")
+      ->type_name("HOST:PORT");
+  serve->add_option("--web-token", arguments->web_token,
+                    "A secret the page and scripts must present (http://HOST:PORT/?token=TOKEN) before they may "
+                    "talk to the modules; required with a --web address other than loopback")
+      ->type_name("TOKEN");
   serve->add_option("--can-capture", arguments->can_capture,
                     "Write every frame of the CAN bus to FILE (simulated time): pcap with link type 227 when FILE "
                     "ends in .pcap (Wireshark, tshark), otherwise a candump -L log")

@@ -1,0 +1,74 @@
+// The web console's protocol (docs/web-console.md, "Protocol"): JSON requests
+// {"id":N,"op":"..."} from a page or a script, each answered by a reply with the same id, and
+// "update" pushes of subscribed values. Everything the console does to a module goes the way a
+// host's request goes: a TMCL module through its TmclHostService on a channel of the console's
+// own (SAP, GAP, STAP ... and any instruction as `motwin tmcl` takes it), a CANopen node by SDO
+// and NMT frames on the virtual bus. So the module's own range and access checks answer, and the
+// page can do nothing a TMCL or CANopen host could not. No sockets here: the web server
+// (host/web/web_server.h) hands messages in, and the unit tests do the same.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "host/can_bus.h"
+#include "host/event_loop.h"
+#include "host/module_descriptor.h"
+#include "host/module_listing.h"
+#include "host/tmcl_host_service.h"
+#include "host/web/web_server.h"
+
+namespace motwin::tools::web {
+
+// One module or node the console reaches.
+struct ConsoleTarget {
+  std::string name;              // "tmcm-1636", or the node's name with --node
+  std::string module;            // the descriptor's name
+  std::string product_name;      // "TMCM-1636"
+  std::string firmware;          // "1636V109"
+  host::ModuleParameterListing listing;
+  host::TmclHostService* tmcl = nullptr;  // a TMCL module served directly
+  uint8_t module_address = 1;             // of its TMCL requests
+  std::optional<uint8_t> canopen_node_id;  // a CANopen node on the bus
+};
+
+class WebConsole {
+ public:
+  static constexpr size_t kMaxPendingRequestsPerSession = 64;
+  static constexpr size_t kMaxSubscribedItems = 64;
+  static constexpr double kMaxUpdateRateHz = 100;
+  // How long an SDO transfer may wait for the node's answer (wall time).
+  static constexpr uint64_t kSdoTimeoutUs = 1'000'000;
+
+  // `sim_time_us` stamps the pushes. `bus` is where CANopen targets are (nullptr: none).
+  WebConsole(host::EventLoop& loop, std::function<uint64_t()> sim_time_us, std::vector<ConsoleTarget> targets,
+             host::CanBus* bus);
+  WebConsole(const WebConsole&) = delete;
+  WebConsole& operator=(const WebConsole&) = delete;
+  ~WebConsole();
+
+  // A session for one page or script; it sends through `connection` until destroyed.
+  std::unique_ptr<host::web::WebSessionHandler> open_session(host::web::WebConnection& connection);
+
+  const std::vector<ConsoleTarget>& targets() const;
+
+  class Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+// The console's targets for `motwin serve`: the module itself (TMCL through `service`, or a
+// CANopen node), or each node of a group. A TMCL module that is only a node of a bus is listed
+// without a way to reach it (the console speaks no TMCL over CAN yet).
+ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
+                          std::string_view firmware_generation, host::TmclHostService* service);
+ConsoleTarget canopen_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
+                             uint8_t node_id);
+
+}  // namespace motwin::tools::web

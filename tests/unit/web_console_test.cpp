@@ -1,0 +1,354 @@
+// The web console's protocol (tools/web/web_console.h) without sockets: requests handed in as
+// text, replies collected from a fake connection, the module run by its host runtime. Each op on
+// a TMCL module (through its TmclHostService) and a CANopen node (SDO and NMT on the virtual
+// bus), bad JSON, unknown ops, the module's own status or abort code for a value out of range or
+// a refused access, and subscriptions pushing batches with the simulated time.
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "host/can_bus.h"
+#include "host/host_runtime.h"
+#include "host/module_registry.h"
+#include "tools/web/web_console.h"
+
+namespace motwin::tools::web {
+namespace {
+
+using Json = nlohmann::json;
+
+class FakeConnection final : public host::web::WebConnection {
+ public:
+  void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
+  void send_latest(std::string message) override { latest = Json::parse(message); }
+
+  std::vector<Json> replies;
+  std::optional<Json> latest;
+};
+
+std::unique_ptr<host::VirtualModule> make(const char* name) {
+  host::ModuleOptions options;
+  options.log = [](const std::string&) {};
+  host::MakeModuleResult made = host::make_module(name, options);
+  EXPECT_TRUE(made) << made.error();
+  return std::move(*made);
+}
+
+// A console on one module, and a session talking to it.
+class ConsoleRig {
+ public:
+  explicit ConsoleRig(const char* module_name) : module_(make(module_name)) {
+    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
+    const host::ModuleDescriptor& descriptor = *host::find_module(module_name);
+    std::vector<ConsoleTarget> targets;
+    if (module_->has_tmcl()) {
+      targets.push_back(tmcl_target(descriptor, std::string(module_->name()), std::string(module_->firmware_version()),
+                                    "", &runtime_->service()));
+    } else {
+      bus_ = std::make_unique<host::CanBus>([this] { return module_->sim_time_us(); });
+      module_->can_node()->connect(*bus_);
+      targets.push_back(canopen_target(descriptor, std::string(module_->name()),
+                                       std::string(module_->firmware_version()), 1));
+    }
+    console_ = std::make_unique<WebConsole>(
+        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), bus_.get());
+    session_ = console_->open_session(connection_);
+    runtime_->start();
+  }
+  ~ConsoleRig() {
+    session_.reset();
+    console_.reset();
+    if (bus_) module_->can_node()->disconnect();
+  }
+
+  // Sends `text` and runs the module until the reply with `id` arrives.
+  Json ask_text(const std::string& text, const Json& id) {
+    const size_t before = connection_.replies.size();
+    session_->on_message(text);
+    // Bounded in wall time: an SDO transfer to a silent node ends after WebConsole::kSdoTimeoutUs.
+    const uint64_t give_up_us = host::monotonic_now_us() + 10'000'000;
+    while (host::monotonic_now_us() < give_up_us) {
+      for (size_t i = before; i < connection_.replies.size(); ++i) {
+        if (connection_.replies[i]["id"] == id) return connection_.replies[i];
+      }
+      runtime_->step(1000);
+    }
+    ADD_FAILURE() << "no reply to " << text;
+    return Json{};
+  }
+  Json ask(Json request) {
+    static int next_id = 1;
+    request["id"] = next_id++;
+    return ask_text(request.dump(), request["id"]);
+  }
+  void send_only(const std::string& text) { session_->on_message(text); }
+  void run_until_replies(size_t count) {
+    for (int step = 0; step < 1000000 && connection_.replies.size() < count; ++step) runtime_->step(0);
+  }
+  // Runs simulated time forward.
+  void run_for_us(uint64_t sim_us) { runtime_->advance_ticks(sim_us / module_->tick_period_us()); }
+  // Runs until a push arrives in the latest slot; returns it.
+  Json next_push() {
+    connection_.latest.reset();
+    for (int step = 0; step < 2000000 && !connection_.latest; ++step) runtime_->step(0);
+    EXPECT_TRUE(connection_.latest.has_value());
+    return connection_.latest.value_or(Json{});
+  }
+  host::VirtualModule& module() { return *module_; }
+  FakeConnection& connection() { return connection_; }
+
+ private:
+  std::unique_ptr<host::VirtualModule> module_;
+  std::unique_ptr<host::HostRuntime> runtime_;
+  std::unique_ptr<host::CanBus> bus_;
+  std::unique_ptr<WebConsole> console_;
+  FakeConnection connection_;
+  std::unique_ptr<host::web::WebSessionHandler> session_;
+};
+
+// --- Messages the console cannot read ---------------------------------------------------------
+
+TEST(WebConsole, bad_json_gets_an_error_reply_with_no_id) {
+  ConsoleRig rig("tmcm-1636");
+  const Json reply = rig.ask_text("{\"id\": 1, \"op\": ", nullptr);
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_EQ(reply["error"], "not a JSON object");
+  EXPECT_EQ(rig.ask_text("[1,2]", nullptr)["error"], "not a JSON object");
+}
+
+TEST(WebConsole, unknown_op_and_missing_fields_are_errors_with_the_request_id) {
+  ConsoleRig rig("tmcm-1636");
+  Json reply = rig.ask({{"op", "fly"}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_NE(reply["error"].get<std::string>().find("unknown op \"fly\""), std::string::npos);
+  reply = rig.ask({{"op", "get"}});
+  EXPECT_NE(reply["error"].get<std::string>().find("\"number\""), std::string::npos);
+  reply = rig.ask({{"op", "get"}, {"module", 3}, {"number", 1}});
+  EXPECT_EQ(reply["error"], "no module 3 (the list has 1)");
+  reply = rig.ask({{"op", "set"}, {"number", 4}, {"value", 5000000000LL}});
+  EXPECT_EQ(reply["error"], "\"value\": does not fit the 32 bits of a TMCL value");
+  reply = rig.ask({{"op", "tmcl"}, {"text", "FLY 1 2 3"}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_NE(reply["error"].get<std::string>().find("FLY"), std::string::npos);
+}
+
+// --- A TMCL module ----------------------------------------------------------------------------
+
+TEST(WebConsole, list_gives_the_descriptor_rows_of_a_tmcl_module) {
+  ConsoleRig rig("tmcm-1636");
+  const Json reply = rig.ask({{"op", "list"}});
+  ASSERT_EQ(reply["ok"], true);
+  ASSERT_EQ(reply["modules"].size(), 1u);
+  const Json& module = reply["modules"][0];
+  EXPECT_EQ(module["name"], "tmcm-1636");
+  EXPECT_EQ(module["protocol"], "tmcl");
+  EXPECT_EQ(module["firmware"], "1636V109");
+  const Json& axis = module["sections"][0];
+  EXPECT_EQ(axis["kind"], "axis");
+  bool found = false;
+  for (const Json& parameter : axis["parameters"]) {
+    if (parameter["number"] != 11) continue;
+    found = true;
+    EXPECT_FALSE(parameter["name"].get<std::string>().empty());
+    EXPECT_LT(parameter["min"].get<int64_t>(), parameter["max"].get<int64_t>());
+    EXPECT_NE(parameter["access"].get<std::string>().find('W'), std::string::npos);
+  }
+  EXPECT_TRUE(found);
+  // User variables (a run of numbers in the descriptor) are listed one by one.
+  EXPECT_EQ(module["sections"][2]["bank"], 2);
+  EXPECT_GT(module["sections"][2]["parameters"].size(), 1u);
+}
+
+TEST(WebConsole, set_in_range_is_taken_and_read_back) {
+  ConsoleRig rig("tmcm-1636");
+  Json reply = rig.ask({{"op", "set"}, {"number", 11}, {"axis", 0}, {"value", 1234}});
+  EXPECT_EQ(reply["ok"], true);
+  EXPECT_EQ(reply["status"], 100);
+  reply = rig.ask({{"op", "get"}, {"number", 11}});
+  EXPECT_EQ(reply["value"], 1234);
+  EXPECT_EQ(reply["status_name"], "ok");
+}
+
+TEST(WebConsole, out_of_range_value_gets_the_modules_status_and_changes_nothing) {
+  ConsoleRig rig("tmcm-1636");
+  // Parameter 11, max current: 0..60000 mA.
+  const int64_t before = rig.ask({{"op", "get"}, {"number", 11}})["value"];
+  const Json reply = rig.ask({{"op", "set"}, {"number", 11}, {"value", 60001}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_EQ(reply["status"], 4);  // what a TMCL host gets for SAP 11, 0, 60001: invalid value
+  EXPECT_EQ(reply["status_name"], "invalid value");
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 11}})["value"], before);
+}
+
+TEST(WebConsole, a_read_only_parameter_refuses_a_set_with_the_modules_status) {
+  ConsoleRig rig("tmcm-1636");
+  // Find a row without W in the descriptor.
+  const Json list = rig.ask({{"op", "list"}});
+  std::optional<int> read_only;
+  for (const Json& parameter : list["modules"][0]["sections"][0]["parameters"]) {
+    if (parameter["access"].get<std::string>().find('W') == std::string::npos) {
+      read_only = parameter["number"];
+      break;
+    }
+  }
+  ASSERT_TRUE(read_only.has_value());
+  const Json reply = rig.ask({{"op", "set"}, {"number", *read_only}, {"value", 1}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_NE(reply["status"], 100);
+}
+
+TEST(WebConsole, global_parameters_store_and_restore_answer_with_status) {
+  ConsoleRig rig("tmcm-1636");
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"kind", "global"}, {"number", 77}, {"bank", 0}})["status"], 100);
+  const Json stored = rig.ask({{"op", "store"}, {"number", 11}, {"axis", 0}});
+  EXPECT_EQ(stored["command"], 7);  // STAP
+  EXPECT_EQ(stored["status"], 100);
+  rig.ask({{"op", "set"}, {"number", 11}, {"value", 777}});
+  const Json restored = rig.ask({{"op", "restore"}, {"number", 11}, {"axis", 0}});
+  EXPECT_EQ(restored["command"], 8);  // RSAP
+  EXPECT_EQ(restored["status"], 100);
+  EXPECT_NE(rig.ask({{"op", "get"}, {"number", 11}})["value"], 777);
+}
+
+TEST(WebConsole, tmcl_takes_mnemonics_as_motwin_tmcl_does) {
+  ConsoleRig rig("tmcm-1636");
+  Json reply = rig.ask({{"op", "tmcl"}, {"text", "SAP 11, 0, 2500"}});
+  EXPECT_EQ(reply["ok"], true);
+  EXPECT_EQ(reply["instruction"], "SAP 11, 0, 2500");
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "gap 11 0"}})["value"], 2500);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "136 0"}})["version"], "1636V109");
+  reply = rig.ask({{"op", "tmcl"}, {"text", "139 0"}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_NE(reply["error"].get<std::string>().find("ASCII"), std::string::npos);
+}
+
+TEST(WebConsole, subscription_pushes_batches_with_advancing_simulated_time) {
+  ConsoleRig rig("tmcm-1636");
+  rig.ask({{"op", "set"}, {"number", 11}, {"value", 1111}});
+  const Json ack = rig.ask({{"op", "subscribe"},
+                            {"items", {{{"kind", "axis"}, {"number", 11}}, {{"kind", "global"}, {"number", 77}}}},
+                            {"rate_hz", 50}});
+  ASSERT_EQ(ack["ok"], true);
+  EXPECT_EQ(ack["items"], 2);
+  const Json first = rig.next_push();
+  EXPECT_EQ(first["push"], "update");
+  ASSERT_EQ(first["values"].size(), 2u);
+  EXPECT_EQ(first["values"][0]["number"], 11);
+  EXPECT_EQ(first["values"][0]["value"], 1111);
+  EXPECT_EQ(first["values"][1]["kind"], "global");
+  const Json second = rig.next_push();
+  EXPECT_GT(second["sim_time_us"].get<uint64_t>(), first["sim_time_us"].get<uint64_t>());
+  EXPECT_EQ(rig.ask({{"op", "unsubscribe"}})["ok"], true);
+  EXPECT_EQ(rig.ask({{"op", "subscribe"}, {"items", Json::array()}, {"rate_hz", 1000}})["ok"], false);
+}
+
+TEST(WebConsole, too_many_waiting_requests_are_refused_not_queued) {
+  ConsoleRig rig("tmcm-1636");
+  // No loop turns in between: no reply can come yet, so the requests wait.
+  for (size_t i = 0; i < WebConsole::kMaxPendingRequestsPerSession; ++i) {
+    rig.send_only(Json{{"id", static_cast<int>(i)}, {"op", "get"}, {"number", 1}}.dump());
+  }
+  EXPECT_TRUE(rig.connection().replies.empty());
+  rig.send_only(Json{{"id", 999}, {"op", "get"}, {"number", 1}}.dump());
+  ASSERT_EQ(rig.connection().replies.size(), 1u);
+  EXPECT_EQ(rig.connection().replies[0]["id"], 999);
+  EXPECT_EQ(rig.connection().replies[0]["ok"], false);
+  // The waiting ones are all answered, and the session takes requests again.
+  rig.run_until_replies(WebConsole::kMaxPendingRequestsPerSession + 1);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 1}})["ok"], true);
+  size_t answered = 0;
+  for (const Json& reply : rig.connection().replies) answered += reply["ok"] == true ? 1 : 0;
+  EXPECT_EQ(answered, WebConsole::kMaxPendingRequestsPerSession + 1);
+}
+
+// --- A CANopen node -----------------------------------------------------------------------------
+
+TEST(WebConsole, canopen_node_objects_sdo_and_nmt) {
+  ConsoleRig rig("tmcm-3216");
+  rig.run_for_us(400'000);  // past the boot-up
+  const Json list = rig.ask({{"op", "list"}});
+  const Json& module = list["modules"][0];
+  EXPECT_EQ(module["protocol"], "canopen");
+  EXPECT_EQ(module["node_id"], 1);
+  EXPECT_EQ(module["sections"][0]["kind"], "objects");
+  EXPECT_EQ(module["sections"][0]["objects"][0]["index"], 0x1000);
+
+  // 1000: device type, read through an SDO upload.
+  Json reply = rig.ask({{"op", "get"}, {"index", 0x1000}, {"sub", 0}});
+  EXPECT_EQ(reply["ok"], true);
+  EXPECT_EQ(reply["data"].get<std::string>().size(), 8u);
+  // A string by a segmented upload.
+  reply = rig.ask({{"op", "sdo_read"}, {"index", 0x1008}, {"sub", 0}});
+  EXPECT_EQ(reply["text"], "TMCM-3216");
+  // Written and read back: 6060 modes of operation (INTEGER8).
+  reply = rig.ask({{"op", "set"}, {"index", 0x6060}, {"sub", 0}, {"value", 1}});
+  EXPECT_EQ(reply["ok"], true);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"index", 0x6060}})["value"], 1);
+  // Read-only: the node's abort code.
+  reply = rig.ask({{"op", "set"}, {"index", 0x1000}, {"sub", 0}, {"value", 1}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_EQ(reply["abort"], "0x06010002");
+  // No such object.
+  reply = rig.ask({{"op", "sdo_read"}, {"index", 0x5FFF}, {"sub", 0}});
+  EXPECT_EQ(reply["abort"], "0x06020000");
+  // Raw write with a size to another node: nobody answers.
+  reply = rig.ask({{"op", "sdo_write"}, {"node", 9}, {"index", 0x6060}, {"sub", 0}, {"value", 1}, {"size", 1}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_EQ(reply["error"], "no answer from node 9");
+
+  // NMT start; a heartbeat shows the new state.
+  EXPECT_EQ(rig.ask({{"op", "set"}, {"index", 0x1017}, {"value", 50}})["ok"], true);
+  rig.run_for_us(100'000);
+  EXPECT_EQ(rig.ask({{"op", "list"}})["modules"][0]["nmt_state"], "pre-operational");
+  EXPECT_EQ(rig.ask({{"op", "nmt"}, {"command", "start"}})["ok"], true);
+  rig.run_for_us(200'000);
+  EXPECT_EQ(rig.ask({{"op", "list"}})["modules"][0]["nmt_state"], "operational");
+  EXPECT_EQ(rig.ask({{"op", "nmt"}, {"command", "jump"}})["ok"], false);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 1 0"}})["ok"], false);
+}
+
+TEST(WebConsole, canopen_subscription_reads_objects) {
+  ConsoleRig rig("tmcm-3216");
+  rig.run_for_us(400'000);
+  ASSERT_EQ(rig.ask({{"op", "subscribe"}, {"items", {{{"index", 0x6041}}, {{"index", 0x6064}}}}, {"rate_hz", 20}})["ok"],
+            true);
+  const Json push = rig.next_push();
+  ASSERT_EQ(push["values"].size(), 2u);
+  EXPECT_EQ(push["values"][0]["index"], 0x6041);
+  EXPECT_TRUE(push["values"][0].contains("value"));
+  EXPECT_TRUE(push["values"][1].contains("value"));
+}
+
+}  // namespace
+}  // namespace motwin::tools::web
+
+namespace motwin::host::web {
+namespace {
+
+TEST(WebEndpoint, loopback_by_default_and_elsewhere_only_with_a_token) {
+  Result<WebEndpointSpec> spec = parse_web_endpoint("127.0.0.1:0");
+  ASSERT_TRUE(spec) << spec.error();
+  EXPECT_EQ(spec->host, "127.0.0.1");
+  EXPECT_EQ(spec->port, 0);
+  spec = parse_web_endpoint("8081");
+  ASSERT_TRUE(spec);
+  EXPECT_EQ(spec->host, "127.0.0.1");
+  EXPECT_EQ(spec->port, 8081);
+  EXPECT_FALSE(parse_web_endpoint("0.0.0.0:8080"));
+  EXPECT_NE(parse_web_endpoint("192.168.1.5:8080").error().find("--web-token"), std::string::npos);
+  spec = parse_web_endpoint("0.0.0.0:8080", "s3cret");
+  ASSERT_TRUE(spec);
+  EXPECT_EQ(spec->token, "s3cret");
+  EXPECT_FALSE(parse_web_endpoint("localhost:8080"));
+  EXPECT_FALSE(parse_web_endpoint("127.0.0.1:70000"));
+  EXPECT_TRUE(is_loopback_ipv4("127.4.5.6"));
+  EXPECT_FALSE(is_loopback_ipv4("128.0.0.1"));
+}
+
+}  // namespace
+}  // namespace motwin::host::web
