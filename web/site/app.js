@@ -1,0 +1,468 @@
+// The Motwin web console: a client of serve's JSON protocol (docs/web-console.md), like any
+// script. Plain JavaScript, no build step; the server's Content-Security-Policy allows no inline
+// script, so everything lives here.
+(function () {
+  "use strict";
+
+  const LIVE_RATE_HZ = 20;
+  const MAX_LIVE_ROWS = 64;  // the server's limit of subscribed items
+  // A CANopen node's values are SDO uploads on the bus: fewer, less often, so that the page's
+  // reading does not load the bus a master shares (16 objects at 10 Hz: about 4 % of 1 Mbit/s).
+  const CANOPEN_LIVE_RATE_HZ = 10;
+  const CANOPEN_MAX_LIVE_ROWS = 16;
+  const HISTORY_LENGTH = 100;
+
+  const $ = (id) => document.getElementById(id);
+  const state = {
+    socket: null,
+    nextId: 1,
+    waiting: new Map(),   // request id -> callback
+    modules: [],
+    module: 0,
+    rows: [],             // rows of the chosen module
+    shown: [],            // rows that pass the filter
+    liveKeys: [],         // keys of the rows whose values are subscribed
+    view: "parameters",
+    history: [],
+    historyIndex: 0,
+  };
+
+  // --- Connection --------------------------------------------------------------------------------
+
+  function socketUrl() {
+    const token = new URLSearchParams(location.search).get("token");
+    const scheme = location.protocol === "https:" ? "wss:" : "ws:";
+    return scheme + "//" + location.host + "/ws" + (token ? "?token=" + encodeURIComponent(token) : "");
+  }
+
+  function setConnection(text, name) {
+    $("connection").textContent = text;
+    document.body.dataset.state = name;
+  }
+
+  function connect() {
+    setConnection("connecting…", "connecting");
+    const socket = new WebSocket(socketUrl(), "motwin");
+    state.socket = socket;
+    socket.addEventListener("open", () => {
+      setConnection("connected", "connected");
+      request({ op: "list" }, onList);
+    });
+    socket.addEventListener("message", (event) => onMessage(event.data));
+    socket.addEventListener("close", () => {
+      state.waiting.clear();
+      setConnection("disconnected: retrying", "disconnected");
+      setTimeout(connect, 2000);
+    });
+  }
+
+  function request(message, callback) {
+    const id = state.nextId++;
+    message.id = id;
+    if (callback) state.waiting.set(id, callback);
+    if (state.socket && state.socket.readyState === WebSocket.OPEN) state.socket.send(JSON.stringify(message));
+    return id;
+  }
+
+  function onMessage(text) {
+    let message;
+    try {
+      message = JSON.parse(text);
+    } catch (error) {
+      return;
+    }
+    if (message.push === "update") return onUpdate(message);
+    if (message.push === "event") return logLine("event", "command " + message.command + " reply, value " + message.value);
+    const callback = state.waiting.get(message.id);
+    if (callback) {
+      state.waiting.delete(message.id);
+      callback(message);
+    }
+  }
+
+  // --- Modules -----------------------------------------------------------------------------------
+
+  function onList(reply) {
+    if (!reply.ok) return;
+    state.modules = reply.modules;
+    const picker = $("module-picker");
+    picker.replaceChildren();
+    for (const module of reply.modules) {
+      const option = document.createElement("option");
+      option.value = module.module;
+      option.textContent = module.name + (module.node_id !== undefined ? " (node " + module.node_id + ")" : "");
+      picker.appendChild(option);
+    }
+    state.module = Math.min(state.module, reply.modules.length - 1);
+    picker.value = String(state.module);
+    chooseModule(state.module);
+  }
+
+  function currentModule() {
+    return state.modules[state.module];
+  }
+
+  function isCanopen() {
+    const module = currentModule();
+    return module && module.protocol === "canopen";
+  }
+
+  function chooseModule(index) {
+    state.module = index;
+    const module = currentModule();
+    if (!module) return;
+    $("module-info").textContent = module.product + " · firmware " + module.firmware +
+      (module.protocol === "none" ? " · not reachable from the console" : "");
+    $("canopen-controls").hidden = !isCanopen();
+    state.rows = rowsOf(module);
+    applyFilter();
+  }
+
+  // One table row per parameter or object entry, with the fields a request needs.
+  function rowsOf(module) {
+    const rows = [];
+    for (const section of module.sections) {
+      if (section.kind === "objects") {
+        for (const object of section.objects) {
+          const hex = object.index.toString(16).toUpperCase().padStart(4, "0");
+          rows.push({
+            key: "o" + hex + "." + object.sub,
+            label: hex + "." + object.sub,
+            section: section.title,
+            name: object.name,
+            unit: object.type,
+            range: object.min !== undefined ? object.min + " … " + object.max : "",
+            access: object.access,
+            defaultValue: object.default,
+            writable: object.access === "rw" || object.access === "wo",
+            readable: object.access !== "wo",
+            address: { module: module.module, index: object.index, sub: object.sub },
+          });
+        }
+        continue;
+      }
+      const prefix = section.kind === "axis" ? "AP " : "GP " + section.bank + ".";
+      for (const parameter of section.parameters) {
+        const address = section.kind === "axis"
+          ? { module: module.module, kind: "axis", number: parameter.number, axis: 0 }
+          : { module: module.module, kind: "global", number: parameter.number, bank: section.bank };
+        rows.push({
+          key: (section.kind === "axis" ? "a" : "g" + section.bank + ".") + parameter.number,
+          label: prefix + parameter.number,
+          section: section.title,
+          name: parameter.name,
+          unit: parameter.unit,
+          range: parameter.min + " … " + parameter.max,
+          access: parameter.access,
+          defaultValue: parameter.default,
+          writable: parameter.access.includes("W"),
+          readable: parameter.access.includes("R"),
+          storable: parameter.access.includes("E"),
+          address: address,
+          description: parameter.description,
+        });
+      }
+    }
+    return rows;
+  }
+
+  // --- Parameters / objects ------------------------------------------------------------------------
+
+  function applyFilter() {
+    const text = $("filter").value.trim().toLowerCase();
+    state.shown = state.rows.filter((row) => !text || row.name.toLowerCase().includes(text) ||
+      row.label.toLowerCase().includes(text) || row.label.toLowerCase().replace(/^(ap|gp) /, "") === text);
+    renderTable();
+    subscribeShown();
+  }
+
+  function renderTable() {
+    const body = $("parameters").tBodies[0];
+    const fragment = document.createDocumentFragment();
+    let section = null;
+    for (const row of state.shown) {
+      if (row.section !== section) {
+        section = row.section;
+        const header = document.createElement("tr");
+        header.className = "section";
+        const cell = document.createElement("th");
+        cell.colSpan = 9;
+        cell.textContent = section;
+        header.appendChild(cell);
+        fragment.appendChild(header);
+      }
+      fragment.appendChild(rowElement(row));
+    }
+    body.replaceChildren(fragment);
+  }
+
+  function cell(text, className) {
+    const element = document.createElement("td");
+    element.textContent = text === undefined ? "" : String(text);
+    if (className) element.className = className;
+    return element;
+  }
+
+  function rowElement(row) {
+    const tr = document.createElement("tr");
+    tr.dataset.key = row.key;
+    if (row.description) tr.title = row.description;
+    tr.append(cell(row.label, "number"), cell(row.name, "name"), cell(row.unit), cell(row.range, "range"),
+      cell(row.access), cell(row.defaultValue, "default"));
+    const valueCell = document.createElement("td");
+    valueCell.className = "value";
+    const input = document.createElement("input");
+    input.type = "text";
+    input.inputMode = "numeric";
+    input.readOnly = !row.writable;
+    input.setAttribute("aria-label", "Value of " + row.label);
+    input.dataset.key = row.key;
+    input.addEventListener("keydown", (event) => {
+      if (event.key === "Enter" && row.writable) {
+        setValue(row, input.value, tr);
+        input.blur();
+      } else if (event.key === "Escape") {
+        input.value = input.dataset.live || "";
+        input.blur();
+      }
+    });
+    valueCell.appendChild(input);
+    tr.appendChild(valueCell);
+    tr.appendChild(cell("", "reply"));
+    const actions = document.createElement("td");
+    actions.className = "actions";
+    if (row.readable) actions.appendChild(button("Read", () => readValue(row, tr)));
+    if (row.storable) {
+      actions.appendChild(button("Store", () => storeRow(row, "store", tr)));
+      actions.appendChild(button("Restore", () => storeRow(row, "restore", tr)));
+    }
+    tr.appendChild(actions);
+    return tr;
+  }
+
+  function button(text, onClick) {
+    const element = document.createElement("button");
+    element.type = "button";
+    element.textContent = text;
+    element.addEventListener("click", onClick);
+    return element;
+  }
+
+  function replyText(reply) {
+    if (reply.error) return reply.error;
+    if (reply.abort) return "abort " + reply.abort + (reply.abort_text ? " (" + reply.abort_text + ")" : "");
+    if (reply.status !== undefined) return reply.status + " " + reply.status_name;
+    return reply.ok ? "ok" : "failed";
+  }
+
+  function showReply(tr, reply) {
+    const target = tr.querySelector(".reply");
+    target.textContent = replyText(reply);
+    target.classList.toggle("error", !reply.ok);
+    tr.dataset.reply = reply.ok ? "ok" : "error";
+  }
+
+  function setValue(row, text, tr) {
+    const value = Number(text.trim());
+    if (!Number.isInteger(value)) {
+      showReply(tr, { ok: false, error: "not an integer" });
+      return;
+    }
+    request(Object.assign({ op: "set", value: value }, row.address), (reply) => {
+      showReply(tr, reply);
+      readValue(row, tr, true);
+    });
+  }
+
+  function readValue(row, tr, keepReply) {
+    request(Object.assign({ op: "get" }, row.address), (reply) => {
+      if (!keepReply) showReply(tr, reply);
+      if (reply.ok) showValue(row.key, reply.value !== undefined ? reply.value : reply.text);
+    });
+  }
+
+  function storeRow(row, op, tr) {
+    request(Object.assign({ op: op }, row.address), (reply) => {
+      showReply(tr, reply);
+      if (op === "restore") readValue(row, tr, true);
+    });
+  }
+
+  function storeShown(op) {
+    const module = currentModule();
+    if (!module) return;
+    if (isCanopen()) {
+      request({ op: op, module: module.module }, (reply) => logLine(reply.ok ? "reply" : "error", op + ": " + replyText(reply)));
+      return;
+    }
+    for (const row of state.shown) {
+      if (row.storable) {
+        const tr = document.querySelector('tr[data-key="' + row.key + '"]');
+        if (tr) storeRow(row, op, tr);
+      }
+    }
+  }
+
+  // Live values: the readable rows shown first, as many as the server subscribes.
+  function subscribeShown() {
+    const limit = isCanopen() ? CANOPEN_MAX_LIVE_ROWS : MAX_LIVE_ROWS;
+    const live = state.shown.filter((row) => row.readable && currentModule().protocol !== "none").slice(0, limit);
+    state.liveKeys = live.map((row) => row.key);
+    $("live-note").textContent = live.length < state.shown.filter((row) => row.readable).length
+      ? "live values for the first " + live.length + " rows; filter to see others" : "";
+    request({ op: "subscribe", rate_hz: isCanopen() ? CANOPEN_LIVE_RATE_HZ : LIVE_RATE_HZ,
+      items: live.map((row) => row.address) });
+  }
+
+  function onUpdate(message) {
+    $("sim-time").textContent = "t = " + (message.sim_time_us / 1e6).toFixed(3) + " s";
+    message.values.forEach((entry, i) => {
+      const key = state.liveKeys[i];
+      if (key === undefined || entry.module !== state.module) return;
+      if (entry.value !== undefined) showValue(key, entry.value);
+      else if (entry.text !== undefined) showValue(key, entry.text);
+    });
+  }
+
+  function showValue(key, value) {
+    const input = document.querySelector('input[data-key="' + key + '"]');
+    if (!input) return;
+    const text = String(value);
+    const changed = input.dataset.live !== undefined && input.dataset.live !== text;
+    input.dataset.live = text;
+    if (document.activeElement !== input) input.value = text;
+    if (changed) {
+      const tr = input.closest("tr");
+      tr.classList.remove("changed");
+      void tr.offsetWidth;  // restarts the highlight's animation
+      tr.classList.add("changed");
+    }
+  }
+
+  // --- Direct mode console -----------------------------------------------------------------------
+
+  function logLine(kind, text) {
+    const log = $("console-log");
+    const item = document.createElement("li");
+    item.className = kind;
+    item.textContent = text;
+    log.appendChild(item);
+    while (log.children.length > 500) log.removeChild(log.firstChild);
+    log.scrollTop = log.scrollHeight;
+  }
+
+  function parseNumber(text) {
+    const trimmed = String(text).trim();
+    if (/^-?0x[0-9a-f]+$/i.test(trimmed)) return (trimmed.startsWith("-") ? -1 : 1) * parseInt(trimmed.replace("-", ""), 16);
+    return /^-?\d+$/.test(trimmed) ? Number(trimmed) : NaN;
+  }
+
+  // An index as the console takes it: hex without a prefix, like the manuals write indices.
+  function parseIndex(text) {
+    const trimmed = String(text).trim();
+    return /^(0x)?[0-9a-f]{1,4}$/i.test(trimmed) ? parseInt(trimmed.replace(/^0x/i, ""), 16) : NaN;
+  }
+
+  function runCommand(line) {
+    const module = currentModule();
+    if (!module) return;
+    logLine("command", "> " + line);
+    if (!isCanopen()) {
+      request({ op: "tmcl", module: module.module, text: line }, (reply) => {
+        if (reply.version) logLine("reply", "version " + reply.version);
+        else if (reply.replied === false) logLine("reply", "sent; no reply");
+        else logLine(reply.ok ? "reply" : "error", reply.status !== undefined
+          ? "status " + reply.status + " (" + reply.status_name + ") value " + reply.value : replyText(reply));
+      });
+      return;
+    }
+    const words = line.trim().split(/[\s,]+/);
+    const verb = (words[0] || "").toLowerCase();
+    if (verb === "nmt") return sendNmt(words[1] || "");
+    if (verb === "r" || verb === "read") return sdoRead(words[1], words[2] || "0");
+    if (verb === "w" || verb === "write") return sdoWrite(words[1], words[2] || "0", words[3]);
+    logLine("error", "CANopen commands: r INDEX SUB · w INDEX SUB VALUE · nmt start|stop|pre-operational|reset-node|reset-communication");
+  }
+
+  function sdoReply(what) {
+    return (reply) => {
+      let text = what + ": " + replyText(reply);
+      if (reply.ok && reply.value !== undefined) text = what + " = " + reply.value + " (0x" + (reply.data || "") + ")";
+      if (reply.ok && reply.text !== undefined) text = what + " = \"" + reply.text + "\"";
+      logLine(reply.ok ? "reply" : "error", text);
+    };
+  }
+
+  function sdoRead(indexText, subText) {
+    const index = parseIndex(indexText), sub = parseNumber(subText);
+    if (Number.isNaN(index) || Number.isNaN(sub)) return logLine("error", "index (hex) and sub-index expected");
+    request({ op: "sdo_read", module: currentModule().module, index: index, sub: sub },
+      sdoReply("read " + indexText + "." + subText));
+  }
+
+  function sdoWrite(indexText, subText, valueText) {
+    const index = parseIndex(indexText), sub = parseNumber(subText), value = parseNumber(valueText);
+    if (Number.isNaN(index) || Number.isNaN(sub) || Number.isNaN(value)) {
+      return logLine("error", "index (hex), sub-index and value expected");
+    }
+    request({ op: "sdo_write", module: currentModule().module, index: index, sub: sub, value: value },
+      sdoReply("write " + indexText + "." + subText));
+  }
+
+  function sendNmt(command) {
+    request({ op: "nmt", module: currentModule().module, command: command },
+      (reply) => logLine(reply.ok ? "reply" : "error", "NMT " + command + ": " + replyText(reply)));
+  }
+
+  function onConsoleKey(event) {
+    const input = $("console-input");
+    if (event.key === "ArrowUp" || event.key === "ArrowDown") {
+      if (state.history.length === 0) return;
+      event.preventDefault();
+      state.historyIndex += event.key === "ArrowUp" ? -1 : 1;
+      state.historyIndex = Math.max(0, Math.min(state.history.length, state.historyIndex));
+      input.value = state.history[state.historyIndex] || "";
+    }
+  }
+
+  function onConsoleSubmit(event) {
+    event.preventDefault();
+    const input = $("console-input");
+    const line = input.value.trim();
+    if (!line) return;
+    if (state.history[state.history.length - 1] !== line) state.history.push(line);
+    if (state.history.length > HISTORY_LENGTH) state.history.shift();
+    state.historyIndex = state.history.length;
+    input.value = "";
+    runCommand(line);
+  }
+
+  // --- Views -------------------------------------------------------------------------------------
+
+  function showView(name) {
+    state.view = name;
+    for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
+      tab.setAttribute("aria-selected", String(tab.dataset.view === name));
+    }
+    for (const view of document.querySelectorAll(".view")) view.hidden = view.id !== "view-" + name;
+    if (name === "console") $("console-input").focus();
+  }
+
+  function start() {
+    for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
+      tab.addEventListener("click", () => showView(tab.dataset.view));
+    }
+    $("module-picker").addEventListener("change", (event) => chooseModule(Number(event.target.value)));
+    $("filter").addEventListener("input", applyFilter);
+    $("store-all").addEventListener("click", () => storeShown("store"));
+    $("restore-all").addEventListener("click", () => storeShown("restore"));
+    $("console-form").addEventListener("submit", onConsoleSubmit);
+    $("console-input").addEventListener("keydown", onConsoleKey);
+    $("sdo-read").addEventListener("click", () => sdoRead($("sdo-index").value, $("sdo-sub").value));
+    $("sdo-write").addEventListener("click", () => sdoWrite($("sdo-index").value, $("sdo-sub").value, $("sdo-value").value));
+    for (const nmt of document.querySelectorAll("[data-nmt]")) nmt.addEventListener("click", () => sendNmt(nmt.dataset.nmt));
+    connect();
+  }
+
+  start();
+})();
