@@ -41,6 +41,9 @@ class WebCanServer(CanServer):
     def __init__(self, motwin, state_dir, extra_args=(), **kwargs):
         super().__init__(motwin, state_dir, extra_args=["--web", "127.0.0.1:0", *extra_args], **kwargs)
 
+    def url(self, path="/"):
+        return f"http://127.0.0.1:{self.web_port}{path}"
+
     def console(self):
         return ConsoleClient(self.web_port)
 

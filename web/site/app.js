@@ -292,15 +292,21 @@
     const module = currentModule();
     if (!module) return;
     if (isCanopen()) {
-      request({ op: op, module: module.module }, (reply) => logLine(reply.ok ? "reply" : "error", op + ": " + replyText(reply)));
+      request({ op: op, module: module.module }, (reply) => { $("live-note").textContent = op + " (1010/1011 sub 1): " + replyText(reply); });
       return;
     }
-    for (const row of state.shown) {
-      if (row.storable) {
-        const tr = document.querySelector('tr[data-key="' + row.key + '"]');
-        if (tr) storeRow(row, op, tr);
-      }
-    }
+    // One at a time: the server answers a session's requests but keeps only so many waiting.
+    const rows = state.shown.filter((row) => row.storable);
+    const next = (i) => {
+      if (i >= rows.length) return;
+      const tr = document.querySelector('tr[data-key="' + rows[i].key + '"]');
+      request(Object.assign({ op: op }, rows[i].address), (reply) => {
+        if (tr) showReply(tr, reply);
+        if (tr && op === "restore") readValue(rows[i], tr, true);
+        next(i + 1);
+      });
+    };
+    next(0);
   }
 
   // Live values: the readable rows shown first, as many as the server subscribes.

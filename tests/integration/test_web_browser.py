@@ -1,0 +1,234 @@
+#!/usr/bin/python3
+"""The web console in a real browser: headless Chromium driven by Selenium (Debian's chromium,
+chromium-driver, python3-selenium) against `motwin serve --web`. Loads the page, reads a live
+value, edits a parameter in the table and sees the module take it (checked over TMCL/TCP), uses
+the direct-mode console from the keyboard, drives a CANopen node, and finds no SEVERE entry in the
+browser's log. A screenshot of each view is kept under <build>/test-artefacts/web-browser/
+(docs/web-console.md). Skips (status 77) only when the browser cannot start."""
+
+import os
+import shutil
+import sys
+import tempfile
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import motwin_harness as mh  # noqa: E402
+from motwin_harness import TcpClient, TempDir, check, check_equal, run_tests  # noqa: E402
+import web_harness as wh  # noqa: E402
+
+try:
+    from selenium import webdriver
+    from selenium.common.exceptions import WebDriverException
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+except ImportError:  # pragma: no cover - reported as a skip
+    webdriver = None
+
+CHROMIUM = "/usr/lib/chromium/chromium"  # the binary itself: /usr/bin/chromium is a shell wrapper
+CHROMEDRIVER = "/usr/bin/chromedriver"
+WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
+MAX_CURRENT = 11  # TMCM-1636 axis parameter: 0..60000 mA
+
+
+def artifacts_dir(motwin):
+    path = os.path.join(os.path.dirname(motwin), "test-artefacts", "web-browser")
+    os.makedirs(path, exist_ok=True)
+    return path
+
+
+class Browser:
+    """Headless Chromium at 1280x800 with its console log recorded; Skipped when it cannot start."""
+
+    def __init__(self):
+        if webdriver is None:
+            raise mh.Skipped("python3-selenium is not installed (scripts/install-deps.sh installs it)")
+        binary = CHROMIUM if os.access(CHROMIUM, os.X_OK) else shutil.which("chromium")
+        if binary is None or not os.access(CHROMEDRIVER, os.X_OK):
+            raise mh.Skipped("chromium or chromium-driver is not installed (scripts/install-deps.sh installs them)")
+        self.profile = tempfile.mkdtemp(prefix="motwin-chromium-")
+        options = webdriver.ChromeOptions()
+        options.binary_location = binary
+        for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
+                     "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                     "--no-first-run", "--disable-quic", "--window-size=1280,800",
+                     "--user-data-dir=" + self.profile):
+            options.add_argument(flag)
+        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+        try:
+            self.driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+        except WebDriverException as error:
+            shutil.rmtree(self.profile, ignore_errors=True)
+            raise mh.Skipped(f"the browser cannot start: {str(error).splitlines()[0]}")
+        self.log = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        try:
+            self.driver.quit()
+        finally:
+            shutil.rmtree(self.profile, ignore_errors=True)
+
+    def wait(self, description, condition):
+        try:
+            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
+        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
+            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
+
+    def find(self, css):
+        return self.driver.find_element(By.CSS_SELECTOR, css)
+
+    def finds(self, css):
+        return self.driver.find_elements(By.CSS_SELECTOR, css)
+
+    def value_of(self, key):
+        elements = self.finds(f'input[data-key="{key}"]')
+        return elements[0].get_attribute("value") if elements else None
+
+    def reply_of(self, key):
+        elements = self.finds(f'tr[data-key="{key}"] td.reply')
+        return elements[0].text if elements else ""
+
+    def set_filter(self, text):
+        field = self.find("#filter")
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(Keys.BACKSPACE)  # an input event, which clear() does not send
+        if text:
+            field.send_keys(text)
+
+    def show(self, view):
+        self.find(f'#tabs [data-view="{view}"]').click()
+        self.wait(f"the {view} view", lambda: self.find(f"#view-{view}").is_displayed())
+
+    def screenshot(self, motwin, name):
+        path = os.path.join(artifacts_dir(motwin), name + ".png")
+        check(self.driver.save_screenshot(path), f"screenshot {path}")
+
+    def check_log_clean(self):
+        self.log += self.driver.get_log("browser")
+        severe = [entry for entry in self.log if entry["level"] == "SEVERE"]
+        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+
+    def console_lines(self):
+        return [item.text for item in self.finds("#console-log li")]
+
+    def type_command(self, text):
+        field = self.find("#console-input")
+        field.send_keys(text)
+        field.send_keys(Keys.ENTER)
+
+
+def test_parameters_and_console(motwin):
+    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+            TcpClient(server.tcp_port) as tmcl:
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        key = f"a{MAX_CURRENT}"
+        # A live value: what the module holds, then what a TMCL host changes it to.
+        before = tmcl.gap(MAX_CURRENT)
+        browser.wait("the live value of AP 11", lambda: browser.value_of(key) == str(before))
+        tmcl.sap(MAX_CURRENT, 1234)
+        browser.wait("the live value to follow SAP over TCP", lambda: browser.value_of(key) == "1234")
+
+        # Filter by name, then by number.
+        browser.set_filter("max current")
+        browser.wait("the filter", lambda: len(browser.finds("#parameters tbody tr[data-key]")) == 1)
+        browser.set_filter("11")
+        browser.wait("the filter by number", lambda: browser.finds(f'tr[data-key="{key}"]') != [])
+        browser.screenshot(motwin, "parameters-filtered")
+        browser.set_filter("")
+        browser.wait("all rows again", lambda: len(browser.finds("#parameters tbody tr[data-key]")) > 50)
+
+        # Edit in place: out of range gets the module's status and changes nothing.
+        field = browser.find(f'input[data-key="{key}"]')
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys("60001", Keys.ENTER)
+        browser.wait("the reply to 60001", lambda: browser.reply_of(key).startswith("4 "))
+        check_equal(tmcl.gap(MAX_CURRENT), 1234, "AP 11 after the page's refused set")
+        # In range: the module takes it.
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys("1500", Keys.ENTER)
+        browser.wait("the reply to 1500", lambda: browser.reply_of(key).startswith("100"))
+        check_equal(tmcl.gap(MAX_CURRENT), 1500, "AP 11 over TCP after the page set it")
+        browser.wait("the table to show 1500", lambda: browser.value_of(key) == "1500")
+        browser.screenshot(motwin, "parameters")
+
+        # The direct-mode console, from the keyboard.
+        browser.show("console")
+        browser.wait("the console's input to have the focus",
+                     lambda: browser.driver.switch_to.active_element.get_attribute("id") == "console-input")
+        browser.type_command("SAP 11, 0, 1600")
+        browser.wait("the SAP reply", lambda: any(line.startswith("status 100") for line in browser.console_lines()))
+        check_equal(tmcl.gap(MAX_CURRENT), 1600, "AP 11 after the console's SAP")
+        browser.type_command("GAP 11, 0")
+        browser.wait("the GAP reply", lambda: any("value 1600" in line for line in browser.console_lines()))
+        browser.type_command("FLY 1")
+        browser.wait("the error for FLY", lambda: any("FLY" in line and not line.startswith(">")
+                                                          for line in browser.console_lines()))
+        # History: arrow up three times is the SAP again.
+        tmcl.sap(MAX_CURRENT, 1000)
+        field = browser.find("#console-input")
+        for _ in range(3):
+            field.send_keys(Keys.ARROW_UP)
+        check_equal(field.get_attribute("value"), "SAP 11, 0, 1600", "the console's history")
+        field.send_keys(Keys.ENTER)
+        browser.wait("the module to take the SAP from history", lambda: tmcl.gap(MAX_CURRENT) == 1600)
+        browser.screenshot(motwin, "console")
+
+        for view in ("scope", "program", "canopen", "world"):
+            browser.show(view)
+            browser.screenshot(motwin, view)
+
+        # A narrow window: nothing wider than the window but the table's own scroller.
+        browser.show("parameters")
+        browser.driver.set_window_size(400, 800)
+        browser.wait("the narrow layout", lambda: browser.driver.execute_script(
+            "return document.documentElement.scrollWidth <= window.innerWidth + 1"))
+        browser.screenshot(motwin, "parameters-narrow")
+        browser.check_log_clean()
+        server.stop()
+
+
+def test_canopen_node(motwin):
+    with Browser() as browser, TempDir() as state, wh.WebCanServer(motwin, state).start() as server:
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.wait("the node's objects", lambda: browser.finds('tr[data-key="o1000.0"]') != [])
+        browser.wait("a live value of 1000 sub 0", lambda: (browser.value_of("o1000.0") or "") != "")
+        # Edit an object: 6060 modes of operation.
+        browser.set_filter("6060")
+        browser.wait("the filtered row", lambda: browser.finds('input[data-key="o6060.0"]') != [])
+        field = browser.find('input[data-key="o6060.0"]')
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys("1", Keys.ENTER)
+        browser.wait("the SDO reply", lambda: browser.reply_of("o6060.0") == "ok")
+        browser.wait("6060 to read 1", lambda: browser.value_of("o6060.0") == "1")
+        browser.screenshot(motwin, "canopen-objects")
+        # The console: SDO and NMT.
+        browser.show("console")
+        browser.type_command("w 1017 0 20")
+        browser.wait("the 1017 write", lambda: any(line.startswith("write 1017.0: ok") for line in browser.console_lines()))
+        browser.find('[data-nmt="start"]').click()
+        browser.wait("the NMT reply", lambda: any(line.startswith("NMT start: ok") for line in browser.console_lines()))
+        browser.type_command("r 1008 0")
+        browser.wait("the device name", lambda: any('"TMCM-3216"' in line for line in browser.console_lines()))
+        browser.type_command("w 1000 0 1")
+        browser.wait("the abort code", lambda: any("abort 0x06010002" in line for line in browser.console_lines()))
+        with server.console() as console:
+            check_equal(console.ask("sdo_read", module=0, index=0x6060, sub=0)["value"], 1, "6060 over the protocol")
+        browser.screenshot(motwin, "canopen-console")
+        browser.check_log_clean()
+        server.stop()
+
+
+if __name__ == "__main__":
+    run_tests([test_parameters_and_console, test_canopen_node])
