@@ -222,6 +222,11 @@ TEST(WebConsole, tmcl_takes_mnemonics_as_motwin_tmcl_does) {
   EXPECT_EQ(reply["instruction"], "SAP 11, 0, 2500");
   EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "gap 11 0"}})["value"], 2500);
   EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "136 0"}})["version"], "1636V109");
+  // 137 (factory defaults) has no reply: the console says so once the module has served it.
+  reply = rig.ask({{"op", "tmcl"}, {"text", "137 0 0 1234"}});
+  EXPECT_EQ(reply["ok"], true);
+  EXPECT_EQ(reply["replied"], false);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 11}})["value"], 2000);  // its default again
   reply = rig.ask({{"op", "tmcl"}, {"text", "139 0"}});
   EXPECT_EQ(reply["ok"], false);
   EXPECT_NE(reply["error"].get<std::string>().find("ASCII"), std::string::npos);

@@ -154,9 +154,14 @@ class WebServer::Impl {
     *alive_ = false;
     if (timer_) loop_.cancel_timer(*timer_);
     if (watching_) loop_.unwatch(uv_backend_fd(&uv_));
-    if (context_ != nullptr) lws_context_destroy(context_);
+    // On a foreign loop lws finishes destroying its context once libuv has closed its handles,
+    // and then clears context_ (info.pcontext). Only lws has handles on this loop, so running it
+    // until none is left ends; a context still there then is destroyed once more.
+    for (int pass = 0; pass < 2 && context_ != nullptr; ++pass) {
+      lws_context_destroy(context_);
+      if (uv_initialised_) uv_run(&uv_, UV_RUN_DEFAULT);
+    }
     if (uv_initialised_) {
-      // libuv closes the handles lws used on the next turns of its loop.
       for (int pass = 0; pass < 100 && uv_loop_close(&uv_) == UV_EBUSY; ++pass) uv_run(&uv_, UV_RUN_NOWAIT);
     }
   }
@@ -178,6 +183,7 @@ class WebServer::Impl {
                    LWS_SERVER_OPTION_HTTP_HEADERS_SECURITY_BEST_PRACTICES_ENFORCE;
     info.foreign_loops = foreign_loops_;
     info.user = this;
+    info.pcontext = &context_;
     context_ = lws_create_context(&info);
     const std::string where = spec_.host + ":" + std::to_string(spec_.port);
     if (context_ == nullptr) return Error{"cannot listen on " + where};
