@@ -135,6 +135,46 @@ TEST(Tmcm3216RestingAxes, an_idle_module_rests_and_every_change_wakes_it_with_th
   }
 }
 
+// A powered axis standing still rests too (its standstill time read alike: before the standby
+// delay 2089, or past the power-down ramp 20B9 at the standby current), and the standby delay and
+// the ramp still come on the very tick they come on with every tick a full one.
+TEST(Tmcm3216RestingAxes, a_powered_axis_at_standstill_rests_and_its_standby_current_comes_on_time) {
+  TwoRigs rigs;
+  rigs.both([](Tmcm3216BoardRig& rig) { rig.nmt(0x01); });
+  rigs.write(0x2089, 5);   // standby after 50 ms
+  rigs.write(0x20B9, 1);   // a power-down step per 2^18 clocks (16.4 ms)
+  rigs.write(0x2003, 200);
+  rigs.write(0x2004, 20);
+  rigs.write(0x6060, 1);
+  rigs.write(0x6040, 6);
+  rigs.ticks(5, "shutdown");
+  rigs.write(0x6040, 7);
+  rigs.ticks(5, "switched on");
+  rigs.write(0x6040, 15);
+  rigs.ticks(200, "operation enabled");
+  const Tmcm3216& resting = constant(rigs.resting);
+  ASSERT_TRUE(resting.stepper(0).power_stage_on());
+  EXPECT_TRUE(resting.axis_resting(0)) << "a powered axis standing still before its standby delay rests";
+  EXPECT_FALSE(resting.stepper(0).standby());
+  const int32_t run_current_ma = resting.stepper(0).current_ma();
+  // Past 2089 the current steps down to the standby current; identical tick for tick.
+  rigs.ticks(12000, "standby delay and power-down ramp");
+  ASSERT_TRUE(resting.stepper(0).power_stage_on());
+  EXPECT_TRUE(resting.stepper(0).standby());
+  EXPECT_LT(resting.stepper(0).current_ma(), run_current_ma);
+  EXPECT_TRUE(resting.axis_resting(0)) << "at the standby current it rests again";
+  // A move wakes it; at the target it rests again and the standby delay starts anew.
+  rigs.write(0x6081, 20000);
+  rigs.write(0x607A, 2000);
+  rigs.write(0x6040, 0x1F);
+  rigs.ticks(3000, "moving from standby");
+  rigs.write(0x6040, 0x0F);
+  rigs.ticks(20000, "standing again");
+  EXPECT_TRUE(resting.stepper(0).standby());
+  EXPECT_TRUE(resting.axis_resting(0));
+  EXPECT_EQ(resting.drive(0).position_actual(), 2000);
+}
+
 // Each way in, on a resting axis: the change shows in the very next tick.
 struct RestingRig : Tmcm3216BoardRig {
   RestingRig() {

@@ -480,8 +480,8 @@ void Tmcm3216::run_axes(uint32_t dt_us) {
   uint8_t brake_duty[kAxisCount] = {};
   for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
     const board::StepperPowerStage& stage = board_.axes[axis];
-    if (!axes_touched_ && axis_resting_[axis] && stage.feedback == resting_feedback_[axis] &&
-        stage.drive == resting_drive_[axis]) {
+    if (!axes_touched_ && axis_resting_[axis] && steppers_[axis].standstill_time_read_alike(dt_us) &&
+        stage.feedback == resting_feedback_[axis] && stage.drive == resting_drive_[axis]) {
       drives_[axis].rest(dt_us);
       steppers_[axis].rest(dt_us);
     } else {
@@ -496,15 +496,17 @@ void Tmcm3216::run_axes(uint32_t dt_us) {
 
 void Tmcm3216::run_axis_checking_rest(uint8_t axis, uint32_t dt_us) {
   // The proof is by comparison: a full tick whose result equals rest() applied to the state
-  // before it, with the same inputs, will do so again. The power stage must be off, because
-  // only then does no part of the tick read the counters rest() advances (the standstill time
-  // sets the standby current of a powered motor; the SYNC timeout is read by set-point writes,
-  // which come through process()).
+  // before it, with the same inputs, will do so again, as long as no part of the tick reads the
+  // counters rest() advances differently. The SYNC timeout is read by set-point writes only,
+  // which come through process(); the standstill time sets the standby current of a powered
+  // motor, so a powered axis rests only while the standstill time stays on the same side of the
+  // standby delay (2089), or once the power-down ramp has reached the standby current
+  // (Tmcm3216Stepper::standstill_time_read_alike, checked again before every resting tick).
   static_assert(std::is_trivially_copyable_v<Tmcm3216Drive> && std::is_trivially_copyable_v<Tmcm3216Stepper> &&
                 std::is_trivially_copyable_v<Tmcm3216Emergencies>);
   Tmcm3216Drive& drive = drives_[axis];
   Tmcm3216Stepper& stepper = steppers_[axis];
-  const bool candidate = resting_enabled_ && !stepper.power_stage_on();
+  const bool candidate = resting_enabled_ && stepper.standstill_time_read_alike(dt_us);
   if (candidate) {
     // Byte copies, so that the comparison below sees padding that the tick leaves alone as equal.
     std::memcpy(static_cast<void*>(&rest_check_drive_), &drive, sizeof(drive));
@@ -516,7 +518,7 @@ void Tmcm3216::run_axis_checking_rest(uint8_t axis, uint32_t dt_us) {
   const board::StepperPowerStage& stage = board_.axes[axis];
   const board::StepperDrive drive_before = stage.drive;
   run_axis(axis, dt_us);
-  axis_resting_[axis] = candidate && !stepper.power_stage_on() && stage.drive == drive_before &&
+  axis_resting_[axis] = candidate && stepper.standstill_time_read_alike(dt_us) && stage.drive == drive_before &&
                         std::memcmp(&rest_check_drive_, &drive, sizeof(drive)) == 0 &&
                         std::memcmp(&rest_check_stepper_, &stepper, sizeof(stepper)) == 0 &&
                         std::memcmp(&rest_check_emergencies_, &emergencies_, sizeof(emergencies_)) == 0;

@@ -268,9 +268,10 @@ class Tmcm3216 final : private canopen::LssDevice {
   Tmcm3216GeneralIo general_io_{};
   Tmcm3216Emergencies emergencies_{};  // table 365 per axis: the single sender of the axes' EMCYs
   // Resting axes (docs/tmcm-3216-drive.md "Idle ticks"): an axis whose full tick changed nothing
-  // but its time counters, with its power stage off, is stepped by rest() while nothing that
-  // run_axis() reads changes: no process() call (frames, service ticks), no call of a mutable
-  // accessor, the same board feedback, the board's drive as the axis left it.
+  // but its time counters, with its power stage off or its motor standing still (within or past
+  // the standby delay as in that tick), is stepped by rest() while nothing that run_axis() reads
+  // changes: no process() call (frames, service ticks), no call of a mutable accessor, the same
+  // board feedback, the board's drive as the axis left it.
   bool resting_enabled_ = true;
   bool axes_touched_ = true;
   std::array<bool, kAxisCount> axis_resting_{};

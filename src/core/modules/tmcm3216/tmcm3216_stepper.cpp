@@ -273,22 +273,39 @@ void Tmcm3216Stepper::run_current_control(const StepperDemand& demand) {
   uint8_t scale = coolstep_.step(config, inputs);
   coolstep_active_ = coolstep_.active();
 
-  const uint64_t delay_us = uint64_t{objects.standby_delay_10ms} * 10000;
   standby_current_reached_ = false;
-  if (!moving_ && standstill_us_ >= delay_us) {
-    const uint64_t into_ramp_us = standstill_us_ - delay_us;
-    if (hold_scale >= run_scale || objects.power_down_ramp == 0) {
-      scale = hold_scale;
-    } else {
-      const double step_us = objects.power_down_ramp * kPowerDownStepUsPerUnit;
-      const auto steps = static_cast<uint64_t>(static_cast<double>(into_ramp_us) / step_us);
-      scale = steps >= static_cast<uint64_t>(run_scale - hold_scale) ? hold_scale
-                                                                    : static_cast<uint8_t>(run_scale - steps);
-    }
+  if (!moving_ && standby_scale(standstill_us_, run_scale, hold_scale, scale)) {
     standby_current_reached_ = scale == hold_scale;
   }
   current_scale_ = scale;
   current_ma_ = current_of_scale(scale);
+}
+
+bool Tmcm3216Stepper::standby_scale(uint64_t standstill_us, uint8_t run_scale, uint8_t hold_scale,
+                                    uint8_t& scale) const {
+  const uint64_t delay_us = uint64_t{objects.standby_delay_10ms} * 10000;
+  if (standstill_us < delay_us) return false;
+  const uint64_t into_ramp_us = standstill_us - delay_us;
+  if (hold_scale >= run_scale || objects.power_down_ramp == 0) {
+    scale = hold_scale;
+  } else {
+    const double step_us = objects.power_down_ramp * kPowerDownStepUsPerUnit;
+    const auto steps = static_cast<uint64_t>(static_cast<double>(into_ramp_us) / step_us);
+    scale = steps >= static_cast<uint64_t>(run_scale - hold_scale) ? hold_scale : static_cast<uint8_t>(run_scale - steps);
+  }
+  return true;
+}
+
+bool Tmcm3216Stepper::standstill_time_read_alike(uint32_t dt_us) const {
+  if (!power_on_) return true;
+  if (moving_) return false;  // a moving tick sets it to 0
+  // The last tick read standstill_us_ (it counts itself), the next one reads it + dt_us.
+  const uint64_t next_us = standstill_us_ < UINT64_MAX - dt_us ? standstill_us_ + dt_us : standstill_us_;
+  const uint8_t run_scale = motion::CoolStep::current_scale_of(objects.run_current);
+  const uint8_t hold_scale = motion::CoolStep::current_scale_of(objects.standby_current);
+  uint8_t scale = 0;
+  if (!standby_scale(next_us, run_scale, hold_scale, scale)) return true;  // both before 2089
+  return standby_scale(standstill_us_, run_scale, hold_scale, scale) && scale == hold_scale;
 }
 
 void Tmcm3216Stepper::write_drive(board::StepperDrive& drive) {

@@ -138,6 +138,12 @@ class Tmcm3216Stepper {
   void rest(uint32_t dt_us) {
     if (!moving_ && standstill_us_ < UINT64_MAX - dt_us) standstill_us_ += dt_us;
   }
+  // Whether the next tick reads the standstill time as the last one did, so that rest() may stand
+  // for it: the power stage is off (only the standby current of a powered motor reads it), or the
+  // motor stands still and the next tick's standstill time lies before 2089 as the last one did, or
+  // the last one's had already taken the power-down ramp (20B9) to the standby current, where
+  // every longer standstill stays (docs/tmcm-3216-drive.md "Idle ticks").
+  bool standstill_time_read_alike(uint32_t dt_us) const;
   // Power-up / NMT reset node: live state cleared, objects kept (loaded by the dictionary).
   void reset();
   // The drive assigns its position counter (homing, 200B sub 3): the next demand at `position`
@@ -191,6 +197,9 @@ class Tmcm3216Stepper {
   void read_encoder(const board::StepperFeedback& feedback, int32_t demand_position);
   void run_power_sequence(const StepperDemand& demand, uint32_t dt_us);
   void run_current_control(const StepperDemand& demand);
+  // At standstill from `standstill_us` on: false before 2089; past it true, and `scale` the
+  // power-down ramp's scale (non-increasing with the time, down to the standby scale `hold_scale`).
+  bool standby_scale(uint64_t standstill_us, uint8_t run_scale, uint8_t hold_scale, uint8_t& scale) const;
   void run_stallguard(const board::StepperFeedback& feedback, const StepperDemand& demand);
   void write_drive(board::StepperDrive& drive);
   int32_t current_of_scale(uint8_t scale) const;
