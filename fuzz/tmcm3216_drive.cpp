@@ -17,6 +17,7 @@
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -60,15 +61,19 @@ bool valid_state_coding(uint16_t sw) {
   return a == 0x00 || a == 0x40 || b == 0x21 || b == 0x23 || b == 0x27 || b == 0x07 || a == 0x0F || a == 0x08;
 }
 
-int64_t read_object(Tmcm3216& device, uint16_t index, uint8_t sub) {
-  canopen::ObjectRef ref;
-  if (device.dictionary().find(index, sub, ref) != canopen::SdoAbort::kNone) return -1;
-  return device.dictionary().value(ref);
-}
-
 void check_statuswords(Tmcm3216& device) {
+  // Each axis' 6041 as find() answers for it, once per process (the object table is constant).
+  static const auto statusword_refs = [&device] {
+    std::array<canopen::ObjectRef, kAxes> refs{};
+    for (uint8_t axis = 0; axis < kAxes; ++axis) {
+      FUZZ_CHECK(device.dictionary().find(static_cast<uint16_t>(0x6041 + axis * 0x800), 0, refs[axis]) ==
+                     canopen::SdoAbort::kNone,
+                 "no statusword for axis %u", axis);
+    }
+    return refs;
+  }();
   for (uint8_t axis = 0; axis < kAxes; ++axis) {
-    const auto sw = static_cast<uint16_t>(read_object(device, static_cast<uint16_t>(0x6041 + axis * 0x800), 0));
+    const auto sw = static_cast<uint16_t>(device.dictionary().value(statusword_refs[axis]));
     FUZZ_CHECK(valid_state_coding(sw), "axis %u statusword %04x is no state of table 234", axis, sw);
     const PdsState state = std::as_const(device).drive(axis).state();
     const uint16_t expected = cia402::state_bits(state);
