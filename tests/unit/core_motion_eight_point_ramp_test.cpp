@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "core/motion/eight_point_ramp.h"
@@ -326,6 +327,35 @@ TEST(EightPointRamp, tvmax_cruises_between_braking_and_accelerating_again) {
   EXPECT_NEAR((ramp.velocity() - held) / kDt, c.amax_pps2, c.amax_pps2 * kTolerance);
   while (!ramp.position_reached()) ramp.step(c, kDt);
   EXPECT_EQ(ramp.position(), 2000000);
+}
+
+// Fuzz finding (eight_point_ramp, 2026-11-27): a stop that ended a few Q32 units (1/2^32
+// microstep) short of where the next target lay left a move of that fraction. TVMAX reduced its
+// speed to what fills the fraction in TVMAX, about 1e-8 pps, which moves the counter by less than
+// one Q32 unit a tick: rounded to nothing, for ever. The last fraction now goes without TVMAX.
+TEST(EightPointRamp, tvmax_never_stalls_on_the_last_fraction_of_a_microstep) {
+  EightPointConfig c;
+  c.vmax_pps = 0.0179;
+  c.amax_pps2 = 100000;
+  c.dmax_pps2 = 100000;
+  c.d2_pps2 = 100000;
+  c.d1_pps2 = 100000;
+  c.tvmax_us = 79929;
+  for (const double stop_from_pps : {0.005, 0.0136, 0.02, 0.05}) {
+    EightPointRamp ramp;
+    ramp.set_state(0, stop_from_pps);
+    ramp.stop();
+    for (int i = 0; i < 100 && !ramp.standstill(); ++i) ramp.step(c, kDt);
+    ASSERT_TRUE(ramp.standstill());
+    ramp.set_position_target(ramp.position());  // the integer part: a fraction of a microstep behind
+    ASSERT_LT(ramp.distance_to_target(), 0.0) << stop_from_pps;
+    int ticks = 0;
+    for (; ticks < 100000 && !ramp.position_reached(); ++ticks) ramp.step(c, kDt);
+    EXPECT_TRUE(ramp.position_reached()) << "from " << stop_from_pps << " pps: " << ramp.distance_to_target()
+                                         << " steps left at " << ramp.velocity() << " pps";
+    EXPECT_EQ(ramp.position(), 0);
+    EXPECT_LT(ticks, 100) << stop_from_pps;
+  }
 }
 
 // hfuzz finding: with TVMAX, one tick of AMAX from rest already left no room for the cruise, so

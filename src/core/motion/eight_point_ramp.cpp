@@ -315,6 +315,7 @@ void EightPointRamp::step_position(const EightPointConfig& config, double dt_s) 
   Motion motion = speed > config.vmax_pps ? decelerate(config, speed, config.vmax_pps, dt_s)
                                           : accelerate(config, speed, config.vmax_pps, dt_s);
   if (config.tvmax_us > 0 && motion.speed_pps > speed) {
+    const Motion without_tvmax = motion;
     const double tvmax_s = config.tvmax_us * 1e-6;
     // TVMAX, manual 1.5: a constant-velocity segment of at least TVMAX where the ramp turns from
     // decelerating to accelerating (a farther target during braking) ...
@@ -331,6 +332,13 @@ void EightPointRamp::step_position(const EightPointConfig& config, double dt_s) 
       // Accelerate only up to the reduced VMAX whose TVMAX cruise still fits; holding the speed
       // instead would keep a move from rest (VSTART 0) at 0 for ever.
       motion = accelerate_within_tvmax(config, speed, motion.speed_pps, remaining, tvmax_s, dt_s);
+    }
+    // A TVMAX cruise too slow to move the counter by one Q32 unit a tick would never cover what is
+    // left (found by fuzzing: a stop ending 4 units short of the target, then 1e-8 pps for ever):
+    // the last fraction of a microstep is driven without it.
+    if (motion.distance * kQ32 < 1.0) {
+      motion = without_tvmax;
+      tvmax_hold_s_ = 0.0;
     }
   } else {
     tvmax_hold_s_ = 0.0;
