@@ -2,10 +2,12 @@
 """The web console in a real browser: headless Chromium driven by Selenium (Debian's chromium,
 chromium-driver, python3-selenium) against `motwin serve --web`. Loads the page, reads a live
 value, edits a parameter in the table and sees the module take it (checked over TMCL/TCP), uses
-the direct-mode console from the keyboard, drives a CANopen node, and finds no SEVERE entry in the
-browser's log. A screenshot of each view is kept under <build>/test-artefacts/web-browser/
+the direct-mode console from the keyboard, watches a motion in the Scope view and exports it,
+drives a CANopen node, and finds no SEVERE entry in the browser's log. A screenshot of each view is kept under <build>/test-artefacts/web-browser/
 (docs/web-console.md). Skips (status 77) only when the browser cannot start."""
 
+import csv
+import io
 import os
 import shutil
 import sys
@@ -24,7 +26,7 @@ try:
     from selenium.webdriver.chrome.service import Service
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from selenium.webdriver.support.ui import WebDriverWait
+    from selenium.webdriver.support.ui import Select, WebDriverWait
 except ImportError:  # pragma: no cover - reported as a skip
     webdriver = None
 
@@ -32,6 +34,10 @@ CHROMIUM = "/usr/lib/chromium/chromium"  # the binary itself: /usr/bin/chromium 
 CHROMEDRIVER = "/usr/bin/chromedriver"
 WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 MAX_CURRENT = 11  # TMCM-1636 axis parameter: 0..60000 mA
+# TMCM-1636 axis parameters the scope plots: target and actual position, actual velocity and
+# torque current; their CSV names.
+SCOPE_CURVES = {"a50": "AP50", "a52": "AP52", "a42": "AP42", "a31": "AP31"}
+SCOPE_TARGET = 40000  # counts: with the default ramp (AP 45 = 1) a motion of about 0.7 s simulated
 
 
 def artifacts_dir(motwin):
@@ -183,7 +189,7 @@ def test_parameters_and_console(motwin):
         browser.wait("the module to take the SAP from history", lambda: tmcl.gap(MAX_CURRENT) == 1600)
         browser.screenshot(motwin, "console")
 
-        for view in ("scope", "program", "canopen", "world"):
+        for view in ("program", "canopen", "world"):
             browser.show(view)
             browser.screenshot(motwin, view)
 
@@ -193,6 +199,121 @@ def test_parameters_and_console(motwin):
         browser.wait("the narrow layout", lambda: browser.driver.execute_script(
             "return document.documentElement.scrollWidth <= window.innerWidth + 1"))
         browser.screenshot(motwin, "parameters-narrow")
+        browser.check_log_clean()
+        server.stop()
+
+
+def scope_js(browser, expression):
+    """The value of `expression` with `scope` the page's current MotwinScope (docs/web-console.md)."""
+    return browser.driver.execute_script(f"const scope = window.motwinConsole.scope; return {expression};")
+
+
+def scope_pushes(browser):
+    return scope_js(browser, "scope ? scope.stats().pushes : 0")
+
+
+def sim_time_shown_s(browser):
+    """The simulated time in the page's header (from the Parameters view's session)."""
+    text = browser.find("#sim-time").text
+    return float(text.split("=")[1].split()[0]) if "=" in text and "–" not in text else None
+
+
+def test_scope(motwin):
+    """The Scope view: four curves of a TMCM-1636 at 25 updates a second follow a motion commanded
+    over TMCL/TCP; pause; CSV and PNG export; the Parameters view stays live meanwhile; leaving the
+    tab stops the scope's subscription."""
+    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+            TcpClient(server.tcp_port) as tmcl:
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.show("scope")
+        check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "25",
+                    "the scope's default rate on a TMCL module")
+        check(browser.find("#scope-start").get_attribute("disabled") is not None, "Start before a curve is picked")
+        # Pick the curves through the filter, as a user would.
+        for key, words in (("a50", "target position"), ("a52", "actual position"), ("a42", "actual velocity"),
+                           ("a31", "31")):
+            field = browser.find("#scope-filter")
+            field.click()
+            field.send_keys(Keys.CONTROL, "a")
+            field.send_keys(Keys.BACKSPACE)
+            field.send_keys(words)
+            browser.wait(f"{key} in the scope's list", lambda: browser.finds(f'#scope-choices input[data-key="{key}"]') != [])
+            browser.find(f'#scope-choices input[data-key="{key}"]').click()
+        browser.wait("four curves picked", lambda: len(browser.finds("#scope-choices input:checked")) == 4)
+
+        check_equal(tmcl.gap(52), 0, "actual position before the motion")
+        browser.find("#scope-start").click()
+        browser.wait("the scope to plot updates", lambda: scope_pushes(browser) >= 5)
+        check_equal(scope_js(browser, "scope.series.map(s => s.name)"), list(SCOPE_CURVES.values()), "the curves")
+        check_equal(scope_js(browser, "scope.uplot.axes.map(a => a.label)"), ["time (s)", "counts", "rpm", "mA"],
+                    "one axis per unit")
+
+        # Both sessions live: the Parameters view still follows a value while the scope runs.
+        tmcl.sap(MAX_CURRENT, 1234)
+        browser.wait("the Parameters view to follow SAP while the scope runs",
+                     lambda: browser.value_of(f"a{MAX_CURRENT}") == "1234")
+
+        # A motion over TMCL/TCP: the plotted actual position goes to the target.
+        tmcl.ok(mh.MVP, mh.MVP_ABS, 0, SCOPE_TARGET, f"MVP ABS, 0, {SCOPE_TARGET}")
+        last_plotted = "const d = scope.uplot.data; return d.slice(1).map(c => c[c.length - 1]);"
+        browser.wait("the plotted actual position to reach the target", lambda: (lambda last: last[0] == SCOPE_TARGET
+                     and last[1] is not None and abs(last[1] - SCOPE_TARGET) <= 20)(
+                         browser.driver.execute_script("const scope = window.motwinConsole.scope; " + last_plotted)))
+        plotted = scope_js(browser, "scope.uplot.data")
+        check(plotted[2][0] is not None and abs(plotted[2][0]) <= 20,
+              f"the plot starts at rest: actual position {plotted[2][0]}")
+        check(any(v is not None and 1000 < v < SCOPE_TARGET - 1000 for v in plotted[2]),
+              f"the plot shows positions on the way: {plotted[2]}")
+        check(any(v is not None and v > 100 for v in plotted[3]), f"the plot shows the velocity: {plotted[3]}")
+        times = plotted[0]
+        check(all(b > a for a, b in zip(times, times[1:])), "plotted times (simulated) increase")
+
+        # Pause: samples are still kept, the view stays.
+        browser.find("#scope-plot .motwin-scope-toolbar button").click()  # the toolbar's first: Pause
+        browser.wait("the scope to pause", lambda: scope_js(browser, "scope.isPaused()"))
+        drawn = scope_js(browser, "scope.stats().lastDrawnTime_s")
+        pushes = scope_pushes(browser)
+        browser.wait("samples while paused", lambda: scope_pushes(browser) >= pushes + 3)
+        check_equal(scope_js(browser, "scope.stats().lastDrawnTime_s"), drawn, "the paused view")
+        browser.find("#scope-plot .motwin-scope-toolbar button").click()  # Run
+        browser.wait("the scope to run again", lambda: not scope_js(browser, "scope.isPaused()"))
+        browser.screenshot(motwin, "scope")
+
+        # CSV export: a header of the curves' names, one row per kept sample.
+        rows = list(csv.reader(io.StringIO(scope_js(browser, "scope.exportCsv()"))))
+        check_equal(rows[0], ["time_s"] + list(SCOPE_CURVES.values()), "the scope's CSV header")
+        samples = [[float(v) if v else None for v in row] for row in rows[1:]]
+        check(len(samples) >= 5 and all(len(row) == 5 for row in samples), f"CSV rows: {len(samples)}")
+        check(all(b[0] > a[0] for a, b in zip(samples, samples[1:])), "CSV times increase")
+        check_equal(samples[-1][1], float(SCOPE_TARGET), "target position in the last CSV row")
+        check(abs(samples[-1][2] - SCOPE_TARGET) <= 20, f"actual position in the last CSV row: {samples[-1][2]}")
+        check(abs(samples[0][2]) <= 20, f"actual position in the first CSV row: {samples[0][2]}")
+        png = scope_js(browser, "scope.exportPng()")
+        check(png.startswith("data:image/png;base64,") and len(png) > 1000, "the scope's PNG export")
+
+        # Leaving the tab stops the scope's session: the header's time (the Parameters view's
+        # session) goes on, the scope gets no more samples.
+        browser.show("console")
+        browser.wait("the scope to stop", lambda: not browser.driver.execute_script(
+            "return window.motwinConsole.scopeRunning;"))
+        pushes = scope_pushes(browser)
+        last_s = scope_js(browser, "scope.stats().lastPushedTime_s")
+        browser.wait("simulated time to go on", lambda: (sim_time_shown_s(browser) or 0) > last_s + 1.0)
+        check_equal(scope_pushes(browser), pushes, "scope samples after leaving the tab")
+        browser.show("scope")
+        check("left the Scope view" in browser.find("#scope-note").text, "the note says why the scope stopped")
+        # Start again: a fresh plot of the same curves.
+        browser.find("#scope-start").click()
+        browser.wait("the restarted scope to plot", lambda: scope_pushes(browser) >= 3)
+        # A narrow window: the scope and its toolbar fit, the plot follows the width.
+        browser.driver.set_window_size(400, 800)
+        browser.wait("the narrow scope", lambda: browser.driver.execute_script(
+            "return document.documentElement.scrollWidth <= window.innerWidth + 1 &&"
+            " window.motwinConsole.scope.uplot.width <= window.innerWidth;"))
+        browser.screenshot(motwin, "scope-narrow")
+        browser.find("#scope-stop").click()
+        browser.wait("Stop", lambda: not browser.driver.execute_script("return window.motwinConsole.scopeRunning;"))
         browser.check_log_clean()
         server.stop()
 
@@ -226,9 +347,23 @@ def test_canopen_node(motwin):
         with server.console() as console:
             check_equal(console.ask("sdo_read", module=0, index=0x6060, sub=0)["value"], 1, "6060 over the protocol")
         browser.screenshot(motwin, "canopen-console")
+        # The scope on a CANopen node: an object's value by SDO at the node's default rate.
+        browser.show("scope")
+        check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "10",
+                    "the scope's default rate on a CANopen node")
+        browser.find("#scope-filter").send_keys("6060")
+        browser.wait("6060 in the scope's list", lambda: browser.finds('#scope-choices input[data-key="o6060.0"]') != [])
+        browser.find('#scope-choices input[data-key="o6060.0"]').click()
+        browser.find("#scope-start").click()
+        browser.wait("6060 plotted", lambda: scope_pushes(browser) >= 3)
+        check_equal(scope_js(browser, "scope.exportCsv().split('\\n')[0]"), "time_s,6060.0", "CSV header")
+        check_equal(scope_js(browser, "scope.stats().points > 0 && scope.uplot.data[1].slice(-1)[0]"), 1,
+                    "the plotted 6060")
+        browser.find("#scope-stop").click()
+        browser.wait("Stop", lambda: not browser.driver.execute_script("return window.motwinConsole.scopeRunning;"))
         browser.check_log_clean()
         server.stop()
 
 
 if __name__ == "__main__":
-    run_tests([test_parameters_and_console, test_canopen_node])
+    run_tests([test_parameters_and_console, test_scope, test_canopen_node])

@@ -11,6 +11,13 @@
   const CANOPEN_LIVE_RATE_HZ = 10;
   const CANOPEN_MAX_LIVE_ROWS = 16;
   const HISTORY_LENGTH = 100;
+  // The Scope view: curves of its own session (a second WebSocket), so that its subscription and
+  // the Parameters view's never replace each other. Rates in updates a second.
+  const SCOPE_MAX_CURVES = 8;
+  const SCOPE_RATES_HZ = [10, 20, 25, 50, 100];
+  const SCOPE_DEFAULT_RATE_HZ = 25;
+  const CANOPEN_SCOPE_RATES_HZ = [5, 10, 20];
+  const CANOPEN_SCOPE_DEFAULT_RATE_HZ = 10;
 
   const $ = (id) => document.getElementById(id);
   const state = {
@@ -25,6 +32,18 @@
     view: "parameters",
     history: [],
     historyIndex: 0,
+    scope: {
+      picked: [],         // keys of the rows picked as curves, in the order picked
+      socket: null,       // the scope's own session while it runs
+      instance: null,     // the MotwinScope of the last run (kept after Stop for zoom and export)
+      running: false,
+      updates: 0,
+    },
+  };
+  // For scripts and tests: the scope of the last run and whether it runs.
+  window.motwinConsole = {
+    get scope() { return state.scope.instance; },
+    get scopeRunning() { return state.scope.running; },
   };
 
   // --- Connection --------------------------------------------------------------------------------
@@ -108,6 +127,11 @@
   }
 
   function chooseModule(index) {
+    stopScope(index !== state.module ? "module changed" : "module list read again");
+    if (state.scope.instance && index !== state.module) {  // its curves were the other module's
+      state.scope.instance.destroy();
+      state.scope.instance = null;
+    }
     state.module = index;
     const module = currentModule();
     if (!module) return;
@@ -116,6 +140,7 @@
     $("canopen-controls").hidden = !isCanopen();
     state.rows = rowsOf(module);
     applyFilter();
+    resetScopeChoices();
   }
 
   // One table row per parameter or object entry, with the fields a request needs.
@@ -443,9 +468,142 @@
     runCommand(line);
   }
 
+  // --- Scope -------------------------------------------------------------------------------------
+
+  function scopeRows() {
+    const module = currentModule();
+    if (!module || module.protocol === "none") return [];
+    return state.rows.filter((row) => row.readable);
+  }
+
+  // A new module: nothing picked, the rates it can take.
+  function resetScopeChoices() {
+    state.scope.picked = [];
+    const rates = isCanopen() ? CANOPEN_SCOPE_RATES_HZ : SCOPE_RATES_HZ;
+    const chosen = isCanopen() ? CANOPEN_SCOPE_DEFAULT_RATE_HZ : SCOPE_DEFAULT_RATE_HZ;
+    const select = $("scope-rate");
+    select.replaceChildren();
+    for (const rate of rates) select.add(new Option(rate + " /s", String(rate), false, rate === chosen));
+    renderScopeChoices();
+  }
+
+  // The module's readable rows (the Parameters view's list) as check boxes; picked ones first.
+  function renderScopeChoices() {
+    const text = $("scope-filter").value.trim().toLowerCase();
+    const picked = state.scope.picked;
+    const rows = scopeRows();
+    const shown = rows.filter((row) => picked.includes(row.key) || !text || row.name.toLowerCase().includes(text) ||
+      row.label.toLowerCase().includes(text));
+    shown.sort((a, b) => (picked.includes(b.key) ? 1 : 0) - (picked.includes(a.key) ? 1 : 0));
+    const fragment = document.createDocumentFragment();
+    for (const row of shown) {
+      const item = document.createElement("li");
+      const label = document.createElement("label");
+      const box = document.createElement("input");
+      box.type = "checkbox";
+      box.dataset.key = row.key;
+      box.checked = picked.includes(row.key);
+      box.disabled = !box.checked && picked.length >= SCOPE_MAX_CURVES;
+      box.addEventListener("change", () => pickCurve(row.key, box.checked));
+      const text = document.createElement("span");
+      text.textContent = row.label + " " + row.name + (row.unit && !isCanopen() ? " (" + row.unit + ")" : "");
+      label.append(box, " ", text);
+      item.appendChild(label);
+      fragment.appendChild(item);
+    }
+    $("scope-choices").replaceChildren(fragment);
+    showScopeNote();
+  }
+
+  function pickCurve(key, picked) {
+    const list = state.scope.picked.filter((k) => k !== key);
+    if (picked && list.length < SCOPE_MAX_CURVES) list.push(key);
+    state.scope.picked = list;
+    renderScopeChoices();
+  }
+
+  function showScopeNote(text) {
+    const scope = state.scope;
+    if (text === undefined) {
+      text = scope.running ? "running, updates: " + scope.updates
+        : scope.picked.length + " of at most " + SCOPE_MAX_CURVES + " curves picked";
+    }
+    $("scope-note").textContent = text;
+    $("scope-start").disabled = scope.running || scope.picked.length === 0;
+    $("scope-stop").disabled = !scope.running;
+    // Rate and window belong to a run: they apply at the next Start.
+    $("scope-rate").disabled = scope.running;
+    $("scope-window").disabled = scope.running;
+  }
+
+  // Start: a fresh plot of the picked curves, fed by a session of its own subscribed to them.
+  function startScope() {
+    const module = currentModule();
+    const rows = state.scope.picked.map((key) => state.rows.find((row) => row.key === key)).filter(Boolean);
+    if (!module || rows.length === 0 || state.scope.running) return;
+    const scope = state.scope;
+    if (scope.instance) scope.instance.destroy();
+    scope.instance = MotwinScope.create($("scope-plot"), {
+      series: rows.map((row) => ({
+        name: row.label.replace(/ /g, ""),
+        label: row.label + " " + row.name,
+        unit: isCanopen() ? "" : row.unit,  // a CANopen dictionary names types, not units
+      })),
+      windowSeconds: Number($("scope-window").value),
+      title: module.name,
+    });
+    const rate = Number($("scope-rate").value);
+    const items = rows.map((row) => row.address);
+    const socket = new WebSocket(socketUrl(), "motwin");
+    scope.socket = socket;
+    scope.running = true;
+    scope.updates = 0;
+    socket.addEventListener("open", () => {
+      if (scope.socket === socket) socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: rate, items: items }));
+    });
+    socket.addEventListener("message", (event) => {
+      if (scope.socket !== socket) return;
+      let message;
+      try {
+        message = JSON.parse(event.data);
+      } catch (error) {
+        return;
+      }
+      if (message.id === 1 && !message.ok) return stopScope("refused: " + (message.error || "failed"));
+      if (message.push !== "update") return;
+      scope.updates++;
+      scope.instance.push(message.sim_time_us / 1e6, message.values.map(curveValue));
+      if (scope.updates % 10 === 1) showScopeNote();
+    });
+    socket.addEventListener("close", () => {
+      if (scope.socket === socket) stopScope("connection closed");
+    });
+    showScopeNote();
+  }
+
+  // A number, or null (a gap) for a value the module refused or that is not a number.
+  function curveValue(entry) {
+    if (entry.error || entry.abort || (entry.status !== undefined && entry.status !== 100 && entry.status !== 101)) return null;
+    return typeof entry.value === "number" ? entry.value : null;
+  }
+
+  // Stop: the session closes, and with it its subscription; the plot stays for zoom and export.
+  function stopScope(why) {
+    const scope = state.scope;
+    if (!scope.running) return;
+    const socket = scope.socket;
+    scope.socket = null;
+    scope.running = false;
+    // Closing a socket still connecting makes the browser log an error: close it once open.
+    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
+    else if (socket) socket.close();
+    showScopeNote((why || "stopped") + "; updates: " + scope.updates);
+  }
+
   // --- Views -------------------------------------------------------------------------------------
 
   function showView(name) {
+    if (name !== "scope") stopScope("left the Scope view");
     state.view = name;
     for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
       tab.setAttribute("aria-selected", String(tab.dataset.view === name));
@@ -463,6 +621,9 @@
     $("store-all").addEventListener("click", () => storeShown("store"));
     $("restore-all").addEventListener("click", () => storeShown("restore"));
     $("console-form").addEventListener("submit", onConsoleSubmit);
+    $("scope-filter").addEventListener("input", renderScopeChoices);
+    $("scope-start").addEventListener("click", startScope);
+    $("scope-stop").addEventListener("click", () => stopScope("stopped"));
     $("console-input").addEventListener("keydown", onConsoleKey);
     $("sdo-read").addEventListener("click", () => sdoRead($("sdo-index").value, $("sdo-sub").value));
     $("sdo-write").addEventListener("click", () => sdoWrite($("sdo-index").value, $("sdo-sub").value, $("sdo-value").value));
