@@ -551,6 +551,8 @@
       })),
       windowSeconds: Number($("scope-window").value),
       title: module.name,
+      // Below the picker, with its toolbar, title and legend, in the window (at 1280x800 too).
+      height: Math.max(180, Math.min(480, Math.floor(window.innerHeight - $("scope-plot").getBoundingClientRect().top - 150))),
     });
     const rate = Number($("scope-rate").value);
     const items = rows.map((row) => row.address);
