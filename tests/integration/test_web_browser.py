@@ -24,6 +24,7 @@ try:
     from selenium import webdriver
     from selenium.common.exceptions import WebDriverException
     from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import Select, WebDriverWait
@@ -220,8 +221,9 @@ def sim_time_shown_s(browser):
 
 def test_scope(motwin):
     """The Scope view: four curves of a TMCM-1636 at 25 updates a second follow a motion commanded
-    over TMCL/TCP; pause; CSV and PNG export; the Parameters view stays live meanwhile; leaving the
-    tab stops the scope's subscription."""
+    over TMCL/TCP; pause and cursor readout; CSV and PNG export; the Parameters view stays live
+    meanwhile; leaving the tab stops the scope's subscription; a restart with a level trigger
+    captures a motion back."""
     with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
             TcpClient(server.tcp_port) as tmcl:
         browser.driver.get(server.url("/"))
@@ -276,6 +278,14 @@ def test_scope(motwin):
         pushes = scope_pushes(browser)
         browser.wait("samples while paused", lambda: scope_pushes(browser) >= pushes + 3)
         check_equal(scope_js(browser, "scope.stats().lastDrawnTime_s"), drawn, "the paused view")
+        # Cursor readout: the values under the mouse, in the legend too.
+        over = browser.find("#scope-plot .u-over")
+        ActionChains(browser.driver).move_to_element_with_offset(over, over.size["width"] // 2 - 5, 0).perform()
+        readout = browser.wait("the cursor readout", lambda: scope_js(browser, "scope.readout()"))
+        check_equal(len(readout["values"]), 4, "readout values")
+        check_equal(readout["values"][0], SCOPE_TARGET, "target position under the cursor")
+        browser.wait("the legend's values", lambda: all(
+            e.text != "–" for e in browser.finds("#scope-plot .u-legend .u-series .u-value")))
         browser.find("#scope-plot .motwin-scope-toolbar button").click()  # Run
         browser.wait("the scope to run again", lambda: not scope_js(browser, "scope.isPaused()"))
         browser.screenshot(motwin, "scope")
@@ -303,9 +313,32 @@ def test_scope(motwin):
         check_equal(scope_pushes(browser), pushes, "scope samples after leaving the tab")
         browser.show("scope")
         check("left the Scope view" in browser.find("#scope-note").text, "the note says why the scope stopped")
-        # Start again: a fresh plot of the same curves.
+        # Start again: a fresh plot of the same curves in a 2 s window, with the toolbar's trigger
+        # on the actual position falling through 20000 counts; a motion back to 0 fires it.
+        Select(browser.find("#scope-window")).select_by_value("2")
         browser.find("#scope-start").click()
         browser.wait("the restarted scope to plot", lambda: scope_pushes(browser) >= 3)
+        selects = browser.finds("#scope-plot .motwin-scope-trigger select")
+        Select(selects[0]).select_by_visible_text("AP 52 actual position")
+        Select(selects[1]).select_by_value("falling")
+        level = browser.find("#scope-plot .motwin-scope-trigger input")
+        level.send_keys(Keys.CONTROL, "a")
+        level.send_keys("20000")
+        browser.find("#scope-plot .motwin-scope-trigger button").click()  # Trigger
+        browser.wait("the trigger to arm", lambda: scope_js(browser, "scope.triggerStatus().state") == "armed")
+        tmcl.ok(mh.MVP, mh.MVP_ABS, 0, 0, "MVP ABS, 0, 0")
+        trigger = browser.wait("the trigger's capture", lambda: (lambda t: t if t["state"] == "triggered" else None)(
+            scope_js(browser, "scope.triggerStatus()")))
+        header, *captured = list(csv.reader(io.StringIO(scope_js(browser, "scope.exportCsv()"))))
+        captured = [[float(v) for v in row] for row in captured]
+        crossing = next(k for k in range(1, len(captured)) if captured[k - 1][2] > 20000 >= captured[k][2])
+        check_equal(captured[crossing][0], trigger["time_s"], "trigger time: the first sample at or past the level")
+        check(captured[0][0] >= trigger["time_s"] - 0.5 - 0.1 and captured[-1][0] <= trigger["time_s"] + 1.5 + 0.1,
+              f"the capture: a quarter of 2 s before the trigger, the rest after ({captured[0][0]} .. {captured[-1][0]})")
+        check(abs(captured[0][2] - SCOPE_TARGET) <= 20 and abs(captured[-1][2]) <= 20,
+              f"the capture from {captured[0][2]} to {captured[-1][2]}")
+        check("triggered" in browser.find("#scope-plot .motwin-scope-status").text, "the trigger's status line")
+        browser.screenshot(motwin, "scope-trigger")
         # A narrow window: the scope and its toolbar fit, the plot follows the width.
         browser.driver.set_window_size(400, 800)
         browser.wait("the narrow scope", lambda: browser.driver.execute_script(
