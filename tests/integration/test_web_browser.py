@@ -351,6 +351,53 @@ def test_scope(motwin):
         server.stop()
 
 
+class WebBusServer(wh.WebServer):
+    """`motwin serve --node tmcm-1636 --node tmcm-3216:node-id=1` on a virtual bus with the web
+    console: two modules in the page's picker."""
+
+    BANNER = r"motwin: node tmcm-1636-1 tmcm-1636 \(1636V1\d\d\) eeprom (.+)"
+    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
+
+    def __init__(self, motwin, state_dir):
+        super().__init__(motwin, state_dir, tcp=False, extra_args=[
+            "--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
+        at = self.args.index("--module")
+        del self.args[at:at + 2]  # --node instead
+
+    def _parse_line(self, text):
+        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
+            return False  # the second node's banner
+        return super()._parse_line(text)
+
+
+def test_scope_module_switch(motwin):
+    """Choosing another module stops the scope and offers the new module's rows and rates."""
+    with Browser() as browser, TempDir() as state, WebBusServer(motwin, state).start() as server:
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
+        browser.show("scope")
+        # The TMCM-1636 speaks TMCL on the bus only: not reachable from the console, nothing to plot.
+        check_equal(browser.finds("#scope-choices input"), [], "no curves of a module the console cannot reach")
+        Select(browser.find("#module-picker")).select_by_value("1")
+        browser.wait("the TMCM-3216's objects", lambda: browser.finds('#scope-choices input[data-key="o6060.0"]') != [])
+        check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "10",
+                    "the CANopen node's default rate")
+        browser.find('#scope-choices input[data-key="o6060.0"]').click()
+        browser.find("#scope-start").click()
+        browser.wait("the scope to plot", lambda: scope_pushes(browser) >= 3)
+        Select(browser.find("#module-picker")).select_by_value("0")
+        browser.wait("the scope to stop", lambda: not browser.driver.execute_script(
+            "return window.motwinConsole.scopeRunning;"))
+        check_equal(browser.driver.execute_script("return window.motwinConsole.scope;"), None,
+                    "the other module's plot is gone")
+        check_equal(browser.finds("#scope-choices input"), [], "the TMCM-3216's objects are gone")
+        check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "25",
+                    "a TMCL module's default rate")
+        browser.check_log_clean()
+        server.stop()
+
+
 def test_canopen_node(motwin):
     with Browser() as browser, TempDir() as state, wh.WebCanServer(motwin, state).start() as server:
         browser.driver.get(server.url("/"))
@@ -399,4 +446,4 @@ def test_canopen_node(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_parameters_and_console, test_scope, test_canopen_node])
+    run_tests([test_parameters_and_console, test_scope, test_scope_module_switch, test_canopen_node])
