@@ -19,19 +19,17 @@ page's screenshot to docs/images/trace-step-response.png. Every wait is for a co
 import base64
 import csv
 import io
-import math
 import os
-import shutil
 import struct
 import subprocess
 import sys
-import tempfile
 import zlib
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from motwin_harness import Skipped, check, check_equal, run_tests  # noqa: E402
+import browser_harness as bh  # noqa: E402
+from motwin_harness import check, check_equal, run_tests  # noqa: E402
 
 SOURCE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 STEP_PROGRAM = os.path.join(SOURCE_ROOT, "tests", "programs", "tmcm1636_position_step.tmc")
@@ -48,55 +46,17 @@ LIVE_WINDOW_S = 2.0
 
 
 def artefact_dir(motwin):
-    path = os.path.join(os.path.dirname(motwin), "test-artefacts", "plot-page")
-    os.makedirs(path, exist_ok=True)
-    return path
+    return bh.artefact_dir(motwin, "plot-page")
 
 
 # --- The browser ---------------------------------------------------------------------------------
 
-class Browser:
-    """Headless Chromium with a fresh profile, its console log captured; Skipped when it cannot start."""
+class Browser(bh.HeadlessChromium):
+    """Headless Chromium for trace pages and the scope component; waits bounded by WAIT_S."""
 
     def __init__(self):
-        try:
-            from selenium import webdriver
-            from selenium.webdriver.chrome.service import Service
-        except ImportError as error:
-            raise Skipped(f"python3-selenium is not installed ({error})")
-        for path in ("/usr/bin/chromedriver", "/usr/lib/chromium/chromium"):
-            if not os.access(path, os.X_OK):
-                raise Skipped(f"{path} is missing (Debian's chromium and chromium-driver)")
-        self.profile = tempfile.mkdtemp(prefix="motwin-chromium-")
-        options = webdriver.ChromeOptions()
-        # Not the /usr/bin/chromium wrapper: it prints a warning from its /dev/shm check.
-        options.binary_location = "/usr/lib/chromium/chromium"
-        for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
-                     "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                     "--no-first-run", "--disable-quic", "--window-size=1280,800",
-                     "--force-device-scale-factor=1", f"--user-data-dir={self.profile}"):
-            options.add_argument(flag)
-        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-        try:
-            # The Debian driver, named: Selenium never looks for (or downloads) another.
-            self.driver = webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=options)
-        except Exception as error:  # noqa: BLE001 - any failure to start is "no browser here"
-            shutil.rmtree(self.profile, ignore_errors=True)
-            raise Skipped(f"headless Chromium does not start: {str(error).splitlines()[0]}")
+        super().__init__()
         self.driver.set_script_timeout(WAIT_S)
-        self.log = []
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        try:
-            self.driver.quit()
-        finally:
-            shutil.rmtree(self.profile, ignore_errors=True)
-
-    def js(self, script, *args):
-        return self.driver.execute_script(script, *args)
 
     def wait_for(self, condition, what):
         """Polls `condition(driver)` until it is truthy; returns its value."""
@@ -117,9 +77,6 @@ class Browser:
             "const step = () => (--left <= 0 ? done(true) : requestAnimationFrame(step));"
             "requestAnimationFrame(step);", count)
 
-    def severe_log_entries(self):
-        self.log += self.driver.get_log("browser")
-        return [entry for entry in self.log if entry.get("level") == "SEVERE"]
 
 
 def decode_png(data_url):

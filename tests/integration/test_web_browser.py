@@ -9,30 +9,24 @@ drives a CANopen node, and finds no SEVERE entry in the browser's log. A screens
 import csv
 import io
 import os
-import shutil
 import sys
-import tempfile
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import motwin_harness as mh  # noqa: E402
 from motwin_harness import TcpClient, TempDir, check, check_equal, run_tests  # noqa: E402
+import browser_harness as bh  # noqa: E402
 import web_harness as wh  # noqa: E402
 
-try:
-    from selenium import webdriver
-    from selenium.common.exceptions import WebDriverException
-    from selenium.webdriver.chrome.service import Service
+try:  # without Selenium, bh.HeadlessChromium skips the tests before any of these is used
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import Select, WebDriverWait
 except ImportError:  # pragma: no cover - reported as a skip
-    webdriver = None
+    pass
 
-CHROMIUM = "/usr/lib/chromium/chromium"  # the binary itself: /usr/bin/chromium is a shell wrapper
-CHROMEDRIVER = "/usr/bin/chromedriver"
 WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 MAX_CURRENT = 11  # TMCM-1636 axis parameter: 0..60000 mA
 # TMCM-1636 axis parameters the scope plots: target and actual position, actual velocity and
@@ -41,45 +35,8 @@ SCOPE_CURVES = {"a50": "AP50", "a52": "AP52", "a42": "AP42", "a31": "AP31"}
 SCOPE_TARGET = 40000  # counts: with the default ramp (AP 45 = 1) a motion of about 0.7 s simulated
 
 
-def artifacts_dir(motwin):
-    path = os.path.join(os.path.dirname(motwin), "test-artefacts", "web-browser")
-    os.makedirs(path, exist_ok=True)
-    return path
-
-
-class Browser:
-    """Headless Chromium at 1280x800 with its console log recorded; Skipped when it cannot start."""
-
-    def __init__(self):
-        if webdriver is None:
-            raise mh.Skipped("python3-selenium is not installed (scripts/install-deps.sh installs it)")
-        binary = CHROMIUM if os.access(CHROMIUM, os.X_OK) else shutil.which("chromium")
-        if binary is None or not os.access(CHROMEDRIVER, os.X_OK):
-            raise mh.Skipped("chromium or chromium-driver is not installed (scripts/install-deps.sh installs them)")
-        self.profile = tempfile.mkdtemp(prefix="motwin-chromium-")
-        options = webdriver.ChromeOptions()
-        options.binary_location = binary
-        for flag in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
-                     "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                     "--no-first-run", "--disable-quic", "--window-size=1280,800",
-                     "--user-data-dir=" + self.profile):
-            options.add_argument(flag)
-        options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-        try:
-            self.driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
-        except WebDriverException as error:
-            shutil.rmtree(self.profile, ignore_errors=True)
-            raise mh.Skipped(f"the browser cannot start: {str(error).splitlines()[0]}")
-        self.log = []
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        try:
-            self.driver.quit()
-        finally:
-            shutil.rmtree(self.profile, ignore_errors=True)
+class Browser(bh.HeadlessChromium):
+    """The console's page in headless Chromium, with helpers for its views."""
 
     def wait(self, description, condition):
         try:
@@ -114,12 +71,11 @@ class Browser:
         self.wait(f"the {view} view", lambda: self.find(f"#view-{view}").is_displayed())
 
     def screenshot(self, motwin, name):
-        path = os.path.join(artifacts_dir(motwin), name + ".png")
+        path = os.path.join(bh.artefact_dir(motwin, "web-browser"), name + ".png")
         check(self.driver.save_screenshot(path), f"screenshot {path}")
 
     def check_log_clean(self):
-        self.log += self.driver.get_log("browser")
-        severe = [entry for entry in self.log if entry["level"] == "SEVERE"]
+        severe = self.severe_log_entries()
         check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
 
     def console_lines(self):
