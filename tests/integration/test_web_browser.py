@@ -146,7 +146,7 @@ def test_parameters_and_console(motwin):
         browser.wait("the module to take the SAP from history", lambda: tmcl.gap(MAX_CURRENT) == 1600)
         browser.screenshot(motwin, "console")
 
-        for view in ("program", "canopen", "world"):
+        for view in ("program", "world"):
             browser.show(view)
             browser.screenshot(motwin, view)
 
@@ -401,5 +401,68 @@ def test_canopen_node(motwin):
         server.stop()
 
 
+def canopen_axis_cell(browser, axis, name):
+    cells = browser.finds(f'#canopen-axes tr[data-axis="{axis}"] td.{name}')
+    return cells[0].text if cells else ""
+
+
+def test_canopen_view(motwin):
+    """The CANopen view of a TMCM-3216: the NMT state as the console hears it, NMT start from the
+    view, the statusword decoded as controlwords go over SDO, the PDO mappings, the errors."""
+    with Browser() as browser, TempDir() as state, wh.WebCanServer(motwin, state).start() as server, \
+            server.console() as console:
+        # A heartbeat, so that the console hears every state the node is in.
+        check(console.ask("sdo_write", module=0, index=0x1017, sub=0, value=20)["ok"], "1017 = 20 ms")
+        listing = console.ask("list")["modules"][0]
+        defaults = {(o["index"], o["sub"]): o for section in listing["sections"] for o in section["objects"]}
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.wait("the node's objects", lambda: browser.finds('tr[data-key="o1000.0"]') != [])
+        browser.show("canopen")
+        nmt_state = lambda: browser.find("#canopen-nmt-state").text  # noqa: E731
+        browser.wait("NMT pre-operational", lambda: nmt_state() == "pre-operational")
+        check_equal(len(browser.finds("#canopen-axes tbody tr")), 3, "one row per axis (6041, 6841, 7041)")
+        browser.wait("axis 0 decoded", lambda: canopen_axis_cell(browser, 0, "cia402-state") == "Switch on disabled")
+        check("6 switch on disabled" in canopen_axis_cell(browser, 0, "bits"), "statusword bit 6 shown")
+        check_equal(canopen_axis_cell(browser, 2, "statusword"), "0x0240", "axis 2's statusword (7041)")
+        browser.find('[data-canopen-nmt="start"]').click()
+        browser.wait("NMT operational", lambda: nmt_state() == "operational")
+        for controlword, expected in ((6, "Ready to switch on"), (7, "Switched on"), (15, "Operation enabled")):
+            check(console.ask("sdo_write", module=0, index=0x6040, sub=0, value=controlword)["ok"],
+                  f"controlword {controlword}")
+            browser.wait(f"axis 0 {expected}", lambda: canopen_axis_cell(browser, 0, "cia402-state") == expected)
+            check(canopen_axis_cell(browser, 0, "controlword").endswith(f"({controlword})"), "the controlword shown")
+        check_equal(canopen_axis_cell(browser, 1, "cia402-state"), "Switch on disabled", "axis 1 untouched")
+        check("2 operation enabled" in canopen_axis_cell(browser, 0, "bits"), "statusword bit 2 shown")
+        # The mode by name: profile position.
+        check(console.ask("sdo_write", module=0, index=0x6060, sub=0, value=1)["ok"], "6060 = 1")
+        browser.wait("mode shown", lambda: canopen_axis_cell(browser, 0, "mode") == "1 profile position")
+        # TPDO 1 of axis 0 (1800 / 1A00) with the dictionary's default mapping.
+        browser.wait("the PDOs read", lambda: browser.find("#canopen-pdo-note").text.startswith("24 of 24"))
+        row = browser.find('#canopen-pdos tr[data-pdo="1A00"]')
+        cells = [c.text for c in row.find_elements(By.TAG_NAME, "td")]
+        entry = defaults[(0x1A00, 1)]["default"]
+        mapped_index, mapped_sub, mapped_bits = entry >> 16, (entry >> 8) & 0xFF, entry & 0xFF
+        check_equal(defaults[(0x1A00, 0)]["default"], 1, "TPDO 1 maps one object by default")
+        check_equal(cells[2], "0x%X" % (defaults[(0x1800, 1)]["default"] & 0x7FF), "TPDO 1 COB-ID")
+        check_equal(cells[2], "0x181", "TPDO 1 COB-ID 0x180 + node 1")
+        check_equal(cells[3], "yes", "TPDO 1 valid")
+        check(cells[4].startswith(str(defaults[(0x1800, 2)]["default"])), f"TPDO 1 transmission type: {cells[4]}")
+        check_equal(cells[5], "%04X.%d %s (%d bit)" % (mapped_index, mapped_sub,
+                                                       defaults[(mapped_index, mapped_sub)]["name"], mapped_bits),
+                    "TPDO 1 mapping")
+        check_equal(cells[5], "6041.0 Statusword (16 bit)", "TPDO 1 maps the statusword")
+        check_equal(browser.find('#canopen-pdos tr[data-pdo="1A40"] td.valid').text, "no", "axis 1's TPDO 1 not valid")
+        # Errors: 1001 live; this node has no 1003, and the view says so.
+        check_equal(browser.find("#canopen-error-register").text, "0x00", "error register")
+        browser.wait("the EMCY history line", lambda: "1003" in browser.find("#canopen-emcy").text)
+        browser.screenshot(motwin, "canopen")
+        # Leaving the view closes its session.
+        browser.show("parameters")
+        browser.check_log_clean()
+        server.stop()
+
+
 if __name__ == "__main__":
-    run_tests([test_parameters_and_console, test_scope, test_scope_module_switch, test_canopen_node])
+    run_tests([test_parameters_and_console, test_scope, test_scope_module_switch, test_canopen_node,
+               test_canopen_view])

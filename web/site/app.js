@@ -141,6 +141,7 @@
     state.rows = rowsOf(module);
     applyFilter();
     resetScopeChoices();
+    if (state.view === "canopen") startCanopenView();
   }
 
   // One table row per parameter or object entry, with the fields a request needs.
@@ -602,16 +603,297 @@
     showScopeNote((why || "stopped") + "; updates: " + scope.updates);
   }
 
+  // --- CANopen -----------------------------------------------------------------------------------
+  // The node's NMT state (as `list` reports what the master heard), each axis's CiA-402 words live
+  // through a session of its own (like the Scope's, so that the Parameters view's subscription
+  // stays), the error register and 1003, and the PDO mappings read by SDO.
+
+  const CANOPEN_VIEW_RATE_HZ = 10;
+  const NMT_POLL_MS = 1000;
+  // CiA-402 state from the statusword: mask, value, name (CiA-402 table 30).
+  const CIA402_STATES = [
+    [0x4F, 0x00, "Not ready to switch on"], [0x4F, 0x40, "Switch on disabled"],
+    [0x6F, 0x21, "Ready to switch on"], [0x6F, 0x23, "Switched on"], [0x6F, 0x27, "Operation enabled"],
+    [0x6F, 0x07, "Quick stop active"], [0x4F, 0x0F, "Fault reaction active"], [0x4F, 0x08, "Fault"],
+  ];
+  const STATUSWORD_BITS = ["ready to switch on", "switched on", "operation enabled", "fault", "voltage enabled",
+    "quick stop", "switch on disabled", "warning", "manufacturer 8", "remote", "target reached",
+    "internal limit active", "mode specific 12", "mode specific 13", "manufacturer 14", "manufacturer 15"];
+  const MODES = { 0: "none", 1: "profile position", 2: "velocity", 3: "profile velocity", 4: "profile torque",
+    6: "homing", 7: "interpolated position", 8: "cyclic sync position", 9: "cyclic sync velocity",
+    10: "cyclic sync torque" };
+  const ERROR_REGISTER_BITS = ["generic", "current", "voltage", "temperature", "communication",
+    "device profile", "reserved", "manufacturer"];
+  // Offsets from an axis's controlword (6040 + n × stride) of what the view shows.
+  const AXIS_OBJECTS = [["statusword", 0x01], ["controlword", 0x00], ["mode", 0x21], ["position", 0x24],
+    ["velocity", 0x2C]];
+
+  const canopen = {
+    socket: null,     // the view's own session while it is shown
+    pollTimer: null,
+    axes: [],         // [{axis, controlword index}]
+    items: [],        // [{axis, what}] in the order subscribed
+    pdoGeneration: 0, // a newer Read (or leaving the view) abandons an older one
+    viewGeneration: 0,
+  };
+
+  function hex4(index) {
+    return index.toString(16).toUpperCase().padStart(4, "0");
+  }
+
+  function ask(message) {
+    return new Promise((resolve) => request(message, resolve));
+  }
+
+  function objectOf(module, index, sub) {
+    for (const section of module.sections) {
+      if (section.kind !== "objects") continue;
+      const found = section.objects.find((object) => object.index === index && object.sub === sub);
+      if (found) return found;
+    }
+    return null;
+  }
+
+  function canopenObjects(module) {
+    return module.sections.filter((section) => section.kind === "objects").flatMap((section) => section.objects);
+  }
+
+  function cia402State(statusword) {
+    const found = CIA402_STATES.find(([mask, value]) => (statusword & mask) === value);
+    return found ? found[2] : "unknown";
+  }
+
+  function bitChips(value, names, faultBits) {
+    const fragment = document.createDocumentFragment();
+    names.forEach((name, bit) => {
+      if (!(value & (1 << bit))) return;
+      const chip = document.createElement("span");
+      chip.className = "bit" + (faultBits.includes(bit) ? " fault" : "");
+      chip.textContent = bit + " " + name;
+      fragment.appendChild(chip);
+    });
+    return fragment;
+  }
+
+  function showNmtState(module) {
+    const element = $("canopen-nmt-state");
+    const text = module && module.nmt_state ? module.nmt_state : "not heard yet";
+    element.textContent = text;
+    element.dataset.state = module && module.nmt_state ? module.nmt_state : "";
+  }
+
+  function startCanopenView() {
+    stopCanopenView();
+    const module = currentModule();
+    const reachable = module && isCanopen();
+    $("canopen-none").hidden = reachable;
+    $("canopen-body").hidden = !reachable;
+    if (!reachable) return;
+    showNmtState(module);
+    $("canopen-note").textContent = "";
+    // The axes: each statusword of the dictionary (6041, 6841, 7041 ...).
+    canopen.axes = canopenObjects(module).filter((object) => object.name === "Statusword" && object.sub === 0)
+      .map((object) => ({ axis: object.axis, base: object.index - 1 }));
+    canopen.items = [];
+    const items = [];
+    for (const axis of canopen.axes) {
+      for (const [what, offset] of AXIS_OBJECTS) {
+        if (!objectOf(module, axis.base + offset, 0)) continue;
+        canopen.items.push({ axis: axis.axis, what: what });
+        items.push({ module: module.module, index: axis.base + offset, sub: 0 });
+      }
+    }
+    canopen.items.push({ axis: null, what: "errors" });
+    items.push({ module: module.module, index: 0x1001, sub: 0 });
+    renderAxes();
+    const socket = new WebSocket(socketUrl(), "motwin");
+    canopen.socket = socket;
+    let nextId = 2;
+    const pollNmt = () => {
+      if (canopen.socket === socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ id: nextId++, op: "list" }));
+    };
+    socket.addEventListener("open", () => {
+      if (canopen.socket !== socket) return;
+      socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: CANOPEN_VIEW_RATE_HZ, items: items.slice(0, CANOPEN_MAX_LIVE_ROWS) }));
+      canopen.pollTimer = setInterval(pollNmt, NMT_POLL_MS);
+    });
+    socket.addEventListener("message", (event) => {
+      if (canopen.socket !== socket) return;
+      let message;
+      try {
+        message = JSON.parse(event.data);
+      } catch (error) {
+        return;
+      }
+      if (message.push === "update") return onCanopenUpdate(message);
+      if (message.id === 1 && !message.ok) $("canopen-note").textContent = "live values refused: " + replyText(message);
+      if (message.id > 1 && message.ok && message.modules) showNmtState(message.modules[module.module]);
+    });
+    socket.addEventListener("close", () => {
+      if (canopen.socket === socket) {
+        stopCanopenView();
+        $("canopen-note").textContent = "live values: connection closed";
+      }
+    });
+    readErrors();
+    readPdos();
+  }
+
+  function stopCanopenView() {
+    canopen.pdoGeneration++;
+    canopen.viewGeneration++;
+    if (canopen.pollTimer) clearInterval(canopen.pollTimer);
+    canopen.pollTimer = null;
+    const socket = canopen.socket;
+    canopen.socket = null;
+    // Closing a socket still connecting makes the browser log an error: close it once open.
+    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
+    else if (socket) socket.close();
+  }
+
+  function renderAxes() {
+    const fragment = document.createDocumentFragment();
+    for (const axis of canopen.axes) {
+      const tr = document.createElement("tr");
+      tr.dataset.axis = axis.axis;
+      tr.append(cell(axis.axis + " (" + hex4(axis.base + 1) + ")"), cell("", "statusword"), cell("", "cia402-state"),
+        cell("", "bits"), cell("", "controlword"), cell("", "mode"), cell("", "position"), cell("", "velocity"));
+      fragment.appendChild(tr);
+    }
+    $("canopen-axes").tBodies[0].replaceChildren(fragment);
+  }
+
+  function onCanopenUpdate(message) {
+    message.values.forEach((entry, i) => {
+      const item = canopen.items[i];
+      if (!item || entry.value === undefined) return;
+      const value = entry.value;
+      if (item.what === "errors") return showErrorRegister(value);
+      const tr = document.querySelector('#canopen-axes tr[data-axis="' + item.axis + '"]');
+      if (!tr) return;
+      const set = (name, text) => { tr.querySelector("td." + name).textContent = text; };
+      if (item.what === "statusword") {
+        set("statusword", "0x" + hex4(value));
+        set("cia402-state", cia402State(value));
+        tr.querySelector("td.bits").replaceChildren(bitChips(value, STATUSWORD_BITS, [3, 7]));
+      } else if (item.what === "controlword") {
+        set("controlword", "0x" + hex4(value) + " (" + value + ")");
+      } else if (item.what === "mode") {
+        set("mode", value + " " + (MODES[value] || "manufacturer/unknown"));
+      } else {
+        set(item.what, String(value));
+      }
+    });
+  }
+
+  function showErrorRegister(value) {
+    $("canopen-error-register").textContent = "0x" + value.toString(16).toUpperCase().padStart(2, "0");
+    const bits = $("canopen-error-bits");
+    bits.replaceChildren(bitChips(value, ERROR_REGISTER_BITS, [0]));
+    if (value === 0) bits.textContent = "no error";
+  }
+
+  // 1001 and the pre-defined error field 1003 (sub 0: how many, then newest first).
+  async function readErrors() {
+    const module = currentModule();
+    const generation = canopen.viewGeneration;
+    const list = $("canopen-emcy");
+    const line = (text, className) => {
+      const item = document.createElement("li");
+      item.textContent = text;
+      if (className) item.className = className;
+      list.appendChild(item);
+    };
+    const register = await ask({ op: "sdo_read", module: module.module, index: 0x1001, sub: 0 });
+    if (generation !== canopen.viewGeneration) return;
+    if (register.ok) showErrorRegister(register.value);
+    const count = await ask({ op: "sdo_read", module: module.module, index: 0x1003, sub: 0 });
+    if (generation !== canopen.viewGeneration) return;
+    list.replaceChildren();
+    if (!count.ok) return line("EMCY history (1003): " + replyText(count), "info");
+    if (count.value === 0) return line("EMCY history (1003): empty", "info");
+    for (let sub = 1; sub <= count.value; sub++) {
+      const entry = await ask({ op: "sdo_read", module: module.module, index: 0x1003, sub: sub });
+      if (generation !== canopen.viewGeneration) return;
+      if (!entry.ok) {
+        line("1003." + sub + ": " + replyText(entry));
+        continue;
+      }
+      const code = entry.value & 0xFFFF, extra = entry.value >>> 16;
+      line("EMCY 0x" + hex4(code) + (extra ? ", additional 0x" + extra.toString(16).toUpperCase() : ""));
+    }
+  }
+
+  // The PDOs the dictionary has: communication 1400.. (RPDO) / 1800.. (TPDO), mapping + 0x200.
+  async function readPdos() {
+    const module = currentModule();
+    const generation = ++canopen.pdoGeneration;
+    const body = $("canopen-pdos").tBodies[0];
+    body.replaceChildren();
+    const communication = canopenObjects(module).filter((object) => object.sub === 1 &&
+      ((object.index >= 0x1400 && object.index < 0x1600) || (object.index >= 0x1800 && object.index < 0x1A00)));
+    communication.sort((a, b) => (a.axis - b.axis) || (b.index >= 0x1800) - (a.index >= 0x1800) || a.index - b.index);
+    const read = (index, sub) => ask({ op: "sdo_read", module: module.module, index: index, sub: sub });
+    let done = 0;
+    for (const object of communication) {
+      const name = object.name.replace(/ communication parameter.*$/, "");
+      const tr = document.createElement("tr");
+      tr.dataset.pdo = hex4(object.index + 0x200);
+      tr.append(cell(name + " (" + hex4(object.index) + " / " + hex4(object.index + 0x200) + ")"), cell(object.axis),
+        cell("", "cob-id"), cell("", "valid"), cell("", "transmission"), cell("", "mapped"));
+      body.appendChild(tr);
+      const cobId = await read(object.index, 1);
+      const transmission = await read(object.index, 2);
+      const count = await read(object.index + 0x200, 0);
+      if (generation !== canopen.pdoGeneration) return;
+      if (cobId.ok) {
+        tr.querySelector("td.cob-id").textContent = "0x" + (cobId.value & 0x7FF).toString(16).toUpperCase();
+        tr.querySelector("td.valid").textContent = (cobId.value >>> 31) ? "no" : "yes";
+      } else {
+        tr.querySelector("td.cob-id").textContent = replyText(cobId);
+      }
+      tr.querySelector("td.transmission").textContent = transmission.ok ? transmissionText(transmission.value) : replyText(transmission);
+      const mapped = [];
+      if (count.ok) {
+        for (let sub = 1; sub <= count.value; sub++) {
+          const entry = await read(object.index + 0x200, sub);
+          if (generation !== canopen.pdoGeneration) return;
+          mapped.push(entry.ok ? mappingText(module, entry.value) : replyText(entry));
+        }
+      }
+      tr.querySelector("td.mapped").textContent = count.ok ? (mapped.join(" · ") || "nothing mapped") : replyText(count);
+      done++;
+      $("canopen-pdo-note").textContent = done + " of " + communication.length + " read";
+    }
+  }
+
+  function transmissionText(type) {
+    if (type === 0) return "0 synchronous (acyclic)";
+    if (type <= 240) return type + " every " + (type === 1 ? "" : type + "th ") + "SYNC";
+    if (type === 252 || type === 253) return type + " RTR only";
+    return type + " event driven";
+  }
+
+  // A mapping entry: index (16 bits), sub (8), length in bits (8); named from the dictionary.
+  function mappingText(module, entry) {
+    const index = entry >>> 16, sub = (entry >>> 8) & 0xFF, bits = entry & 0xFF;
+    const object = objectOf(module, index, sub);
+    const name = object ? object.name : index < 8 ? "dummy" : "not in the dictionary";
+    return hex4(index) + "." + sub + " " + name + " (" + bits + " bit)";
+  }
+
   // --- Views -------------------------------------------------------------------------------------
 
   function showView(name) {
     if (name !== "scope") stopScope("left the Scope view");
+    if (name !== "canopen") stopCanopenView();
     state.view = name;
     for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
       tab.setAttribute("aria-selected", String(tab.dataset.view === name));
     }
     for (const view of document.querySelectorAll(".view")) view.hidden = view.id !== "view-" + name;
     if (name === "console") $("console-input").focus();
+    if (name === "canopen") startCanopenView();
   }
 
   function start() {
@@ -630,6 +912,12 @@
     $("sdo-read").addEventListener("click", () => sdoRead($("sdo-index").value, $("sdo-sub").value));
     $("sdo-write").addEventListener("click", () => sdoWrite($("sdo-index").value, $("sdo-sub").value, $("sdo-value").value));
     for (const nmt of document.querySelectorAll("[data-nmt]")) nmt.addEventListener("click", () => sendNmt(nmt.dataset.nmt));
+    for (const nmt of document.querySelectorAll("[data-canopen-nmt]")) {
+      nmt.addEventListener("click", () => request({ op: "nmt", module: currentModule().module, command: nmt.dataset.canopenNmt },
+        (reply) => { $("canopen-note").textContent = "NMT " + nmt.dataset.canopenNmt + ": " + replyText(reply); }));
+    }
+    $("canopen-pdo-read").addEventListener("click", readPdos);
+    $("canopen-errors-read").addEventListener("click", () => { if (canopen.socket) readErrors(); });
     connect();
   }
 
