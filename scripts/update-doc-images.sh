@@ -3,7 +3,8 @@
 # docs/images/trace-step-response.png is the screenshot tests/integration/test_plot_page.py takes
 # of the page `motwin run --plot` writes for a TMCM-1636 position step, docs/images/web-scope.png
 # the one tests/integration/test_web_browser.py takes of the console's Scope view with a triggered
-# capture of a motion (docs/web-console.md).
+# capture of a motion, docs/images/web-canopen.png the one of the CANopen view of a TMCM-3216
+# (docs/web-console.md).
 #   scripts/update-doc-images.sh [BUILD_DIR]   (default build; needs Chromium, see the README)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,4 +14,6 @@ mkdir -p docs/images
 cp "$build_dir/test-artefacts/plot-page/trace-step-response.png" docs/images/trace-step-response.png
 /usr/bin/python3 tests/integration/test_web_browser.py --motwin "$build_dir/motwin" --only test_scope
 cp "$build_dir/test-artefacts/web-browser/scope-trigger.png" docs/images/web-scope.png
-echo "updated docs/images/trace-step-response.png docs/images/web-scope.png"
+/usr/bin/python3 tests/integration/test_web_browser.py --motwin "$build_dir/motwin" --only test_canopen_view
+cp "$build_dir/test-artefacts/web-browser/canopen.png" docs/images/web-canopen.png
+echo "updated docs/images/trace-step-response.png docs/images/web-scope.png docs/images/web-canopen.png"
