@@ -149,6 +149,9 @@ def test_parameters_and_console(motwin):
         for view in ("program", "world"):
             browser.show(view)
             browser.screenshot(motwin, view)
+        browser.show("canopen")  # a TMCL module: the view says it is for CANopen nodes
+        check(browser.find("#canopen-none").is_displayed() and not browser.find("#canopen-body").is_displayed(),
+              "the CANopen view of a TMCL module")
 
         # A narrow window: nothing wider than the window but the table's own scroller.
         browser.show("parameters")
