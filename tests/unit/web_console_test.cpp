@@ -5,6 +5,7 @@
 // a refused access, and subscriptions pushing batches with the simulated time.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,7 +27,9 @@ class FakeConnection final : public host::web::WebConnection {
  public:
   void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
   void send_latest(std::string message) override { latest = Json::parse(message); }
+  size_t queued_bytes() const override { return queued; }
 
+  size_t queued = 0;  // what the fake pretends a page left unread
   std::vector<Json> replies;
   std::optional<Json> latest;
 };
@@ -98,6 +101,18 @@ class ConsoleRig {
     for (int step = 0; step < 2000000 && !connection_.latest; ++step) runtime_->step(0);
     EXPECT_TRUE(connection_.latest.has_value());
     return connection_.latest.value_or(Json{});
+  }
+  // Runs until a "frames" push arrives after reply `from`; returns it (null: none came within
+  // `wait_us` of wall time; pushes are due every WebConsole::kMonitorPeriodUs).
+  Json next_frames_push(size_t from, uint64_t wait_us = 5'000'000) {
+    const uint64_t give_up_us = host::monotonic_now_us() + wait_us;
+    while (host::monotonic_now_us() < give_up_us) {
+      for (size_t i = from; i < connection_.replies.size(); ++i) {
+        if (connection_.replies[i].value("push", "") == "frames") return connection_.replies[i];
+      }
+      runtime_->step(1000);
+    }
+    return Json{};
   }
   host::VirtualModule& module() { return *module_; }
   FakeConnection& connection() { return connection_; }
@@ -327,6 +342,73 @@ TEST(WebConsole, canopen_subscription_reads_objects) {
   EXPECT_EQ(push["values"][0]["index"], 0x6041);
   EXPECT_TRUE(push["values"][0].contains("value"));
   EXPECT_TRUE(push["values"][1].contains("value"));
+}
+
+// --- The bus monitor -----------------------------------------------------------------------------
+
+// The frames of pushes from reply `from` on, in order.
+std::vector<Json> pushed_frames(const FakeConnection& connection, size_t from) {
+  std::vector<Json> frames;
+  for (size_t i = from; i < connection.replies.size(); ++i) {
+    if (connection.replies[i].value("push", "") != "frames") continue;
+    for (const Json& frame : connection.replies[i]["frames"]) frames.push_back(frame);
+  }
+  return frames;
+}
+
+TEST(WebConsole, monitor_pushes_the_bus_frames_heard_and_sent) {
+  ConsoleRig rig("tmcm-3216");
+  const Json on = rig.ask({{"op", "monitor"}});
+  EXPECT_EQ(on["ok"], true);
+  EXPECT_EQ(on["enable"], true);
+  const size_t from = rig.connection().replies.size();
+  ASSERT_EQ(rig.ask({{"op", "nmt"}, {"command", "start"}})["ok"], true);
+  ASSERT_EQ(rig.ask({{"op", "sdo_read"}, {"index", 0x1008}})["ok"], true);
+  Json push;
+  std::vector<Json> frames;
+  const auto seen = [&frames](uint32_t id, const char* data) {
+    return std::any_of(frames.begin(), frames.end(),
+                       [&](const Json& frame) { return frame["id"] == id && frame["data"] == data; });
+  };
+  // The console's NMT start, the node's TPDO 1 (statusword 0x0240) and an SDO upload's request.
+  for (int i = 0; i < 20 && !(seen(0x000, "0101") && seen(0x181, "4002") && seen(0x601, "4008100000000000")); ++i) {
+    push = rig.next_frames_push(rig.connection().replies.size());
+    ASSERT_FALSE(push.is_null());
+    frames = pushed_frames(rig.connection(), from);
+  }
+  EXPECT_TRUE(seen(0x000, "0101"));
+  EXPECT_TRUE(seen(0x181, "4002"));
+  EXPECT_TRUE(seen(0x601, "4008100000000000"));
+  EXPECT_EQ(push["dropped"], 0);
+  for (const Json& frame : frames) EXPECT_TRUE(frame["t_us"].is_number_unsigned());
+  EXPECT_EQ(rig.ask({{"op", "monitor"}, {"enable", false}})["enable"], false);
+  const size_t after_off = rig.connection().replies.size();
+  ASSERT_EQ(rig.ask({{"op", "nmt"}, {"command", "stop"}})["ok"], true);
+  EXPECT_TRUE(rig.next_frames_push(after_off, 5 * WebConsole::kMonitorPeriodUs).is_null());
+  EXPECT_EQ(rig.ask({{"op", "monitor"}, {"enable", 1}})["ok"], false);
+}
+
+TEST(WebConsole, monitor_keeps_a_bounded_buffer_for_a_slow_page_and_counts_what_it_drops) {
+  ConsoleRig rig("tmcm-3216");
+  ASSERT_EQ(rig.ask({{"op", "sdo_write"}, {"index", 0x1017}, {"value", 1}})["ok"], true);  // 1000 frames/s
+  rig.connection().queued = WebConsole::kMonitorMaxQueuedBytes + 1;  // the page reads nothing
+  ASSERT_EQ(rig.ask({{"op", "monitor"}})["ok"], true);
+  const size_t from = rig.connection().replies.size();
+  rig.run_for_us(3'000'000);  // 3000 heartbeats
+  EXPECT_TRUE(rig.next_frames_push(from, 5 * WebConsole::kMonitorPeriodUs).is_null());  // held: the page is behind
+  rig.connection().queued = 0;
+  const Json push = rig.next_frames_push(from);
+  ASSERT_FALSE(push.is_null());
+  EXPECT_EQ(push["frames"].size(), WebConsole::kMaxFramesPerMonitorPush);
+  EXPECT_GE(push["dropped"].get<uint64_t>(), 3000 - WebConsole::kMaxMonitorBufferedFrames);
+  EXPECT_EQ(push["frames"][0]["id"], 0x701);  // the oldest first
+}
+
+TEST(WebConsole, monitor_needs_a_bus) {
+  ConsoleRig rig("tmcm-1636");
+  const Json reply = rig.ask({{"op", "monitor"}});
+  EXPECT_EQ(reply["ok"], false);
+  EXPECT_EQ(reply["error"], "no CAN bus on this serve");
 }
 
 }  // namespace

@@ -81,6 +81,8 @@ class WebServer::Impl {
    public:
     Session(Impl& server, lws* wsi) : server_(server), wsi_(wsi) {}
 
+    size_t queued_bytes() const override { return queued_bytes_; }
+
     void send_text(std::string message) override {
       queued_bytes_ += message.size();
       queue_.push_back(std::move(message));

@@ -42,6 +42,8 @@ class WebConnection {
   virtual void send_text(std::string message) = 0;
   // The newest push replaces one not yet sent: sent after the queued replies.
   virtual void send_latest(std::string message) = 0;
+  // Bytes queued by send_text and not yet written (a page that does not keep up).
+  virtual size_t queued_bytes() const { return 0; }
 
  protected:
   ~WebConnection() = default;

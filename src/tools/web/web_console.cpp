@@ -160,7 +160,7 @@ class SdoMaster final : public host::CanBusEndpoint {
   }
   void nmt(uint8_t command, uint8_t node) {
     const uint8_t bytes[2] = {command, node};
-    bus_.send(id_, can::make_frame(0x000, bytes, 2));
+    transmit(can::make_frame(0x000, bytes, 2));
   }
   // The NMT state the node last announced (boot-up: 0, heartbeat: 4, 5, 127); none yet: nullopt.
   std::optional<uint8_t> announced_state(uint8_t node) const {
@@ -169,7 +169,12 @@ class SdoMaster final : public host::CanBusEndpoint {
     return found->second;
   }
 
-  void on_frame(const can::CanFrame& frame, uint64_t) override {
+  // Every frame the console hears on the bus and every one it sends (the bus does not echo a
+  // client's own frames), for the `monitor` op.
+  std::function<void(const can::CanFrame&, uint64_t timestamp_us)> monitor;
+
+  void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override {
+    if (monitor) monitor(frame, timestamp_us);
     if (frame.extended || frame.rtr) return;
     if (frame.id > 0x700 && frame.id <= 0x77F && frame.dlc >= 1) {
       states_[static_cast<uint8_t>(frame.id - 0x700)] = static_cast<uint8_t>(frame.data[0] & 0x7F);
@@ -249,13 +254,13 @@ class SdoMaster final : public host::CanBusEndpoint {
       bytes[0] = 0x40;
     }
     arm_timeout(node, transfer);
-    bus_.send(id_, can::make_frame(0x600u + node, bytes, 8));
+    transmit(can::make_frame(0x600u + node, bytes, 8));
   }
 
   void send_segment_request(uint8_t node, Transfer& transfer) {
     const uint8_t bytes[8] = {static_cast<uint8_t>(0x60 | (transfer.toggle << 4)), 0, 0, 0, 0, 0, 0, 0};
     arm_timeout(node, transfer);
-    bus_.send(id_, can::make_frame(0x600u + node, bytes, 8));
+    transmit(can::make_frame(0x600u + node, bytes, 8));
   }
 
   void arm_timeout(uint8_t node, Transfer& transfer) {
@@ -278,8 +283,13 @@ class SdoMaster final : public host::CanBusEndpoint {
                               static_cast<uint8_t>(abort_code >> 8),
                               static_cast<uint8_t>(abort_code >> 16),
                               static_cast<uint8_t>(abort_code >> 24)};
-    bus_.send(id_, can::make_frame(0x600u + node, bytes, 8));
+    transmit(can::make_frame(0x600u + node, bytes, 8));
     finish(node, SdoAnswer{false, 0, {}, "SDO protocol error (the console aborted with " + std::to_string(abort_code) + ")"});
+  }
+
+  void transmit(const can::CanFrame& frame) {
+    bus_.send(id_, frame);
+    if (monitor) monitor(frame, bus_.now_us());
   }
 
   void finish(uint8_t node, SdoAnswer answer) {
@@ -393,7 +403,12 @@ class WebConsole::Impl {
                                                [this, i](const TmclAnswer& answer) { broadcast_event(i, answer); });
       }
     }
-    if (bus != nullptr) sdo_ = std::make_unique<SdoMaster>(*bus, loop_);
+    if (bus != nullptr) {
+      sdo_ = std::make_unique<SdoMaster>(*bus, loop_);
+      sdo_->monitor = [this](const can::CanFrame& frame, uint64_t timestamp_us) {
+        broadcast_frame(frame, timestamp_us);
+      };
+    }
   }
 
   ~Impl() {
@@ -434,6 +449,7 @@ class WebConsole::Impl {
   void session_detached(Session* session) { sessions_.erase(session); }
 
   void broadcast_event(size_t index, const TmclAnswer& answer);
+  void broadcast_frame(const can::CanFrame& frame, uint64_t timestamp_us);
 
   // The dictionary entry of a CANopen target, or nullptr.
   const host::DictionaryEntry* entry(const ConsoleTarget& target, uint16_t index, uint8_t sub) const {
@@ -523,6 +539,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
   ~Session() override {
     link_->session = nullptr;
     stop_subscription();
+    stop_monitor();
     console_.session_detached(this);
   }
 
@@ -556,9 +573,11 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     } else if (name == "unsubscribe") {
       stop_subscription();
       return send(Json{{"id", id}, {"ok", true}});
+    } else if (name == "monitor") {
+      error = monitor_op(request, id);
     } else {
       error = "unknown op \"" + name + "\" (list, get, set, store, restore, tmcl, sdo_read, sdo_write, nmt, "
-              "subscribe, unsubscribe)";
+              "subscribe, unsubscribe, monitor)";
     }
     if (!error.empty()) send(Json{{"id", id}, {"ok", false}, {"error", error}});
   }
@@ -1006,9 +1025,83 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
         Json{{"push", "update"}, {"sim_time_us", batch.sim_time_us}, {"values", batch.values}}.dump());
   }
 
+  // {"op":"monitor","enable":true|false}: "frames" pushes of the bus's frames, or none.
+  std::string monitor_op(const Json& request, const Json& id) {
+    if (console_.sdo() == nullptr) return "no CAN bus on this serve";
+    const auto enable = request.find("enable");
+    if (enable != request.end() && !enable->is_boolean()) return "\"enable\": expected true or false";
+    const bool on = enable == request.end() || enable->get<bool>();
+    stop_monitor();
+    send(Json{{"id", id}, {"ok", true}, {"enable", on}});
+    if (on) {
+      monitoring_ = true;
+      schedule_monitor_push(host::monotonic_now_us() + kMonitorPeriodUs);
+    }
+    return {};
+  }
+
+ public:
+  void on_bus_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
+    if (!monitoring_) return;
+    if (monitored_.size() >= kMaxMonitorBufferedFrames) {
+      ++monitor_dropped_;  // a slow page: the newest frames go, counted; the buffer stays bounded
+      return;
+    }
+    monitored_.push_back(MonitoredFrame{frame, timestamp_us});
+  }
+
+ private:
+  struct MonitoredFrame {
+    can::CanFrame frame;
+    uint64_t timestamp_us;
+  };
+
+  void stop_monitor() {
+    if (monitor_timer_) console_.loop().cancel_timer(*monitor_timer_);
+    monitor_timer_.reset();
+    monitoring_ = false;
+    monitored_.clear();
+    monitor_dropped_ = 0;
+  }
+
+  void schedule_monitor_push(uint64_t due_us) {
+    monitor_timer_ = console_.loop().add_timer_at(due_us, [this] {
+      monitor_timer_.reset();
+      push_frames();
+      schedule_monitor_push(host::monotonic_now_us() + kMonitorPeriodUs);
+    });
+  }
+
+  // One push of the oldest frames, unless the page has not read what was sent before: then they
+  // wait in the bounded buffer.
+  void push_frames() {
+    if (monitored_.empty() && monitor_dropped_ == monitor_dropped_sent_) return;
+    if (connection_.queued_bytes() > kMonitorMaxQueuedBytes) return;
+    Json frames = Json::array();
+    const size_t count = std::min(monitored_.size(), kMaxFramesPerMonitorPush);
+    for (size_t i = 0; i < count; ++i) {
+      const MonitoredFrame& monitored = monitored_.front();
+      const uint8_t* data = monitored.frame.data;
+      const std::vector<uint8_t> bytes(data, data + std::min<size_t>(monitored.frame.dlc, 8));
+      Json frame = {{"t_us", monitored.timestamp_us}, {"id", monitored.frame.id}, {"data", hex_text(bytes)}};
+      if (monitored.frame.rtr) frame["rtr"] = true;
+      if (monitored.frame.extended) frame["extended"] = true;
+      frames.push_back(std::move(frame));
+      monitored_.pop_front();
+    }
+    monitor_dropped_sent_ = monitor_dropped_;
+    connection_.send_text(
+        Json{{"push", "frames"}, {"frames", std::move(frames)}, {"dropped", monitor_dropped_}}.dump());
+  }
+
   Impl& console_;
   host::web::WebConnection& connection_;
   std::shared_ptr<SessionLink> link_;
+  bool monitoring_ = false;
+  std::deque<MonitoredFrame> monitored_;
+  uint64_t monitor_dropped_ = 0;
+  uint64_t monitor_dropped_sent_ = 0;
+  std::optional<host::EventLoop::TimerId> monitor_timer_;
   size_t pending_ = 0;
   std::vector<Item> subscribed_;
   uint64_t period_us_ = 100'000;
@@ -1019,6 +1112,10 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
 
 void WebConsole::Impl::broadcast_event(size_t index, const TmclAnswer& answer) {
   for (Session* session : sessions_) session->send_event(index, answer);
+}
+
+void WebConsole::Impl::broadcast_frame(const can::CanFrame& frame, uint64_t timestamp_us) {
+  for (Session* session : sessions_) session->on_bus_frame(frame, timestamp_us);
 }
 
 WebConsole::WebConsole(host::EventLoop& loop, std::function<uint64_t()> sim_time_us, std::vector<ConsoleTarget> targets,

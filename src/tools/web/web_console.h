@@ -44,6 +44,13 @@ class WebConsole {
   static constexpr double kMaxUpdateRateHz = 100;
   // How long an SDO transfer may wait for the node's answer (wall time).
   static constexpr uint64_t kSdoTimeoutUs = 1'000'000;
+  // The bus monitor (op "monitor"): a "frames" push every kMonitorPeriodUs (wall time) of at most
+  // kMaxFramesPerMonitorPush frames; at most kMaxMonitorBufferedFrames wait (more are dropped and
+  // counted), and none is pushed while the page leaves more than kMonitorMaxQueuedBytes unread.
+  static constexpr uint64_t kMonitorPeriodUs = 100'000;
+  static constexpr size_t kMaxFramesPerMonitorPush = 200;
+  static constexpr size_t kMaxMonitorBufferedFrames = 1000;
+  static constexpr size_t kMonitorMaxQueuedBytes = 64 * 1024;
 
   // `sim_time_us` stamps the pushes. `bus` is where CANopen targets are (nullptr: none).
   WebConsole(host::EventLoop& loop, std::function<uint64_t()> sim_time_us, std::vector<ConsoleTarget> targets,
