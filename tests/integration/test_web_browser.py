@@ -459,6 +459,32 @@ def test_canopen_view(motwin):
         # Errors: 1001 live; this node has no 1003, and the view says so.
         check_equal(browser.find("#canopen-error-register").text, "0x00", "error register")
         browser.wait("the EMCY history line", lambda: "1003" in browser.find("#canopen-emcy").text)
+        # The bus monitor: the view's NMT start, the node's heartbeats and TPDO 1 decoded.
+        def monitor_rows():  # in one script: rows come and go while Selenium reads
+            return browser.driver.execute_script(
+                "return [...document.querySelectorAll('#monitor tbody tr')].map(r => [...r.cells].map(c => c.textContent));")
+        browser.wait("heartbeats in the monitor", lambda: any(
+            row[2] == "Heartbeat 1" and row[4] == "operational" for row in monitor_rows()))
+        rows = monitor_rows()
+        check(any(row[2] == "TPDO 1 node 1" and row[1] == "0x181" for row in rows), "TPDO 1 in the monitor")
+        check(any(row[2] == "SDO request 1" and row[4].startswith("initiate upload 6041.0") for row in rows),
+              "the view's SDO requests in the monitor")
+        monitor_note = lambda: browser.find("#monitor-note").text  # noqa: E731
+        browser.find("#monitor-hide-sdo").click()
+        browser.find("#monitor-clear").click()
+        browser.wait("frames without SDO", lambda: len(monitor_rows()) >= 3)
+        check(not any(row[2].startswith("SDO") for row in monitor_rows()), "SDO hidden")
+        browser.find("#monitor-pause").click()
+        paused_rows = len(monitor_rows())
+        paused_frames = int(monitor_note().split(" frames")[0].split("· ")[-1])
+        browser.wait("frames counted while paused", lambda: int(monitor_note().split(" frames")[0].split("· ")[-1])
+                     > paused_frames + 20)
+        check_equal(len(monitor_rows()), paused_rows, "no rows added while paused")
+        browser.find("#monitor-pause").click()
+        browser.find("#monitor-hide-sdo").click()
+        browser.driver.execute_script("document.getElementById('monitor').scrollIntoView(false);")
+        browser.screenshot(motwin, "canopen-monitor")
+        browser.driver.execute_script("window.scrollTo(0, 0);")
         browser.screenshot(motwin, "canopen")
         # A narrow window: the tables scroll in their own boxes, the page does not.
         browser.driver.set_window_size(400, 800)

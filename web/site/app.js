@@ -634,6 +634,7 @@
     axes: [],         // [{axis, controlword index}]
     items: [],        // [{axis, what}] in the order subscribed
     pdoGeneration: 0, // a newer Read (or leaving the view) abandons an older one
+    monitor: { paused: false, frames: 0, dropped: 0, shown: 0 },
     viewGeneration: 0,
   };
 
@@ -706,6 +707,9 @@
     canopen.items.push({ axis: null, what: "errors" });
     items.push({ module: module.module, index: 0x1001, sub: 0 });
     renderAxes();
+    canopen.monitor.frames = 0;
+    canopen.monitor.dropped = 0;
+    showMonitorNote();
     const socket = new WebSocket(socketUrl(), "motwin");
     canopen.socket = socket;
     let nextId = 2;
@@ -715,6 +719,7 @@
     socket.addEventListener("open", () => {
       if (canopen.socket !== socket) return;
       socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: CANOPEN_VIEW_RATE_HZ, items: items.slice(0, CANOPEN_MAX_LIVE_ROWS) }));
+      socket.send(JSON.stringify({ id: 0, op: "monitor", enable: true }));
       canopen.pollTimer = setInterval(pollNmt, NMT_POLL_MS);
     });
     socket.addEventListener("message", (event) => {
@@ -726,6 +731,7 @@
         return;
       }
       if (message.push === "update") return onCanopenUpdate(message);
+      if (message.push === "frames") return onFrames(message);
       if (message.id === 1 && !message.ok) $("canopen-note").textContent = "live values refused: " + replyText(message);
       if (message.id > 1 && message.ok && message.modules) showNmtState(message.modules[module.module]);
     });
@@ -867,6 +873,86 @@
     }
   }
 
+  // --- Bus monitor: the "frames" pushes of the `monitor` op, decoded by the predefined
+  // connection set of CiA-301 (COB-ID = function code + node ID).
+
+  const MONITOR_ROWS = 500;
+  const NMT_COMMANDS = { 1: "start", 2: "stop", 128: "enter pre-operational", 129: "reset node", 130: "reset communication" };
+  const HEARTBEAT_STATES = { 0: "boot-up", 4: "stopped", 5: "operational", 127: "pre-operational" };
+  const SDO_REQUESTS = { 0: "download segment", 1: "initiate download", 2: "initiate upload", 3: "upload segment", 4: "abort" };
+  const SDO_RESPONSES = { 0: "upload segment", 1: "download segment", 2: "initiate upload", 3: "initiate download", 4: "abort" };
+
+  function bytesOf(hex) {
+    const bytes = [];
+    for (let i = 0; i + 1 < hex.length; i += 2) bytes.push(parseInt(hex.substr(i, 2), 16));
+    return bytes;
+  }
+
+  function u16(bytes, at) { return bytes[at] | (bytes[at + 1] << 8); }
+  function u32(bytes, at) { return (u16(bytes, at) | (u16(bytes, at + 2) << 16)) >>> 0; }
+
+  function sdoText(bytes, names) {
+    const specifier = bytes[0] >> 5;
+    let text = names[specifier] || "specifier " + specifier;
+    if (specifier === 4) return text + " " + hex4(u16(bytes, 1)) + "." + bytes[3] + " code 0x" + u32(bytes, 4).toString(16).toUpperCase().padStart(8, "0");
+    if (names === SDO_REQUESTS ? (specifier === 1 || specifier === 2) : (specifier === 2 || specifier === 3)) {
+      text += " " + hex4(u16(bytes, 1)) + "." + bytes[3];
+      if ((bytes[0] & 3) === 3) text += " = " + u32(bytes, 4) % Math.pow(2, 8 * (4 - ((bytes[0] >> 2) & 3)));
+    }
+    return text;
+  }
+
+  // [service, meaning] of a frame.
+  function decodeFrame(frame) {
+    const id = frame.id, bytes = bytesOf(frame.data);
+    if (frame.extended) return ["extended", ""];
+    if (id === 0) return ["NMT", (NMT_COMMANDS[bytes[0]] || "command " + bytes[0]) + (bytes[1] ? " node " + bytes[1] : " all nodes")];
+    if (id === 0x80) return ["SYNC", bytes.length ? "counter " + bytes[0] : ""];
+    const node = id & 0x7F, fn = id & 0x780;
+    if (fn === 0x80) return ["EMCY " + node, bytes.length >= 3 ? "error 0x" + hex4(u16(bytes, 0)) + ", register 0x" + bytes[2].toString(16).toUpperCase().padStart(2, "0") : ""];
+    if (id === 0x100) return ["TIME", ""];
+    if (fn >= 0x180 && fn <= 0x500) {
+      const number = ((fn - 0x100) >> 8) + (fn & 0x80 ? 1 : 0);  // TPDO n: 0x180 + (n - 1) × 0x100, RPDO n: 0x200 + ...
+      return [(fn & 0x80 ? "TPDO " : "RPDO ") + number + " node " + node, frame.rtr ? "remote request" : ""];
+    }
+    if (fn === 0x580) return ["SDO response " + node, sdoText(bytes, SDO_RESPONSES)];
+    if (fn === 0x600) return ["SDO request " + node, sdoText(bytes, SDO_REQUESTS)];
+    if (fn === 0x700) return ["Heartbeat " + node, frame.rtr ? "node guarding" : HEARTBEAT_STATES[bytes[0] & 0x7F] || "state " + (bytes[0] & 0x7F)];
+    return ["other", ""];
+  }
+
+  function onFrames(message) {
+    const monitor = canopen.monitor;
+    monitor.frames += message.frames.length;
+    monitor.dropped = message.dropped;
+    if (!monitor.paused) {
+      const hideSdo = $("monitor-hide-sdo").checked;
+      const body = $("monitor").tBodies[0];
+      const fragment = document.createDocumentFragment();
+      for (const frame of message.frames) {
+        const [service, meaning] = decodeFrame(frame);
+        if (hideSdo && service.startsWith("SDO")) continue;
+        const tr = document.createElement("tr");
+        tr.append(cell((frame.t_us / 1e6).toFixed(4)), cell("0x" + frame.id.toString(16).toUpperCase().padStart(3, "0")),
+          cell(service, "service"), cell(frame.rtr ? "RTR" : frame.data.replace(/(..)(?!$)/g, "$1 ")), cell(meaning, "meaning"));
+        fragment.appendChild(tr);
+      }
+      const wrap = body.closest(".table-wrap");
+      const atBottom = wrap.scrollTop + wrap.clientHeight >= wrap.scrollHeight - 4;
+      body.appendChild(fragment);
+      while (body.rows.length > MONITOR_ROWS) body.deleteRow(0);
+      if (atBottom) wrap.scrollTop = wrap.scrollHeight;
+    }
+    showMonitorNote();
+  }
+
+  function showMonitorNote() {
+    const monitor = canopen.monitor;
+    $("monitor-note").textContent = (monitor.paused ? "paused · " : "") + monitor.frames + " frames" +
+      (monitor.dropped ? " · " + monitor.dropped + " dropped by the server (the page was behind)" : "");
+    $("monitor-pause").textContent = monitor.paused ? "Run" : "Pause";
+  }
+
   function transmissionText(type) {
     if (type === 0) return "0 synchronous (acyclic)";
     if (type <= 240) return type + " every " + (type === 1 ? "" : type + "th ") + "SYNC";
@@ -917,6 +1003,11 @@
         (reply) => { $("canopen-note").textContent = "NMT " + nmt.dataset.canopenNmt + ": " + replyText(reply); }));
     }
     $("canopen-pdo-read").addEventListener("click", readPdos);
+    $("monitor-pause").addEventListener("click", () => {
+      canopen.monitor.paused = !canopen.monitor.paused;
+      showMonitorNote();
+    });
+    $("monitor-clear").addEventListener("click", () => $("monitor").tBodies[0].replaceChildren());
     $("canopen-errors-read").addEventListener("click", () => { if (canopen.socket) readErrors(); });
     connect();
   }
