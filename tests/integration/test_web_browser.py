@@ -465,10 +465,16 @@ def test_canopen_view(motwin):
                 "return [...document.querySelectorAll('#monitor tbody tr')].map(r => [...r.cells].map(c => c.textContent));")
         browser.wait("heartbeats in the monitor", lambda: any(
             row[2] == "Heartbeat 1" and row[4] == "operational" for row in monitor_rows()))
-        rows = monitor_rows()
-        check(any(row[2] == "TPDO 1 node 1" and row[1] == "0x181" for row in rows), "TPDO 1 in the monitor")
-        check(any(row[2] == "SDO request 1" and row[4].startswith("initiate upload 6041.0") for row in rows),
-              "the view's SDO requests in the monitor")
+        # TPDO 1 is event driven (statusword changes) and the monitor keeps the last 500 frames, so
+        # the TPDOs of the controlwords above may have scrolled out (seen under load): a change now.
+        for controlword, expected in ((7, "Switched on"), (15, "Operation enabled")):
+            check(console.ask("sdo_write", module=0, index=0x6040, sub=0, value=controlword)["ok"],
+                  f"controlword {controlword}")
+            browser.wait(f"axis 0 {expected} again", lambda: canopen_axis_cell(browser, 0, "cia402-state") == expected)
+        browser.wait("TPDO 1 in the monitor", lambda: any(
+            row[2] == "TPDO 1 node 1" and row[1] == "0x181" for row in monitor_rows()))
+        browser.wait("the view's SDO requests in the monitor", lambda: any(
+            row[2] == "SDO request 1" and row[4].startswith("initiate upload 6041.0") for row in monitor_rows()))
         monitor_note = lambda: browser.find("#monitor-note").text  # noqa: E731
         browser.find("#monitor-hide-sdo").click()
         browser.find("#monitor-clear").click()
