@@ -282,6 +282,13 @@ void EightPointRamp::step_position(const EightPointConfig& config, double dt_s) 
     // A move starts with a jump to VSTART (never above VMAX).
     direction = sign_of(distance);
     speed = min_of(config.vstart_pps, config.vmax_pps);
+  } else if (distance == 0.0 && speed <= deceleration_band(config, speed).rate_pps2 * dt_s * (1.0 + kRelativeSlack) +
+                                            1e-9 * (1.0 + speed)) {
+    // On the target with less speed left than one tick of braking takes away (the braking curve
+    // ended the last tick exactly there): at rest here. Braking on as below would end a fraction of
+    // a microstep past the target (found by fuzzing: one count beyond at 50 µs).
+    come_to_rest(config);
+    return;
   } else if (direction * distance <= 0.0) {
     // Moving away from the target (it changed behind the axis, or the axis overshot): brake with
     // the D bands, come to rest, wait TZEROWAIT, then the next tick starts the move back.
