@@ -12,8 +12,8 @@
 //   than the steepest rate of the profile (plus the stop's deceleration);
 // - a drop to 0 happens only from VSTOP/VSTART plus one tick of the steepest rate;
 // and at the end: a position move from rest ends exactly on the integer target, at rest, without
-// overshoot (one count tolerated with ticks longer than the drive's 50 µs), within the time the
-// profile allows (cruise + ramps + TZEROWAIT + TVMAX, with slack).
+// overshoot (at every tick length), within the time the profile allows (cruise + ramps +
+// TZEROWAIT + TVMAX, with slack).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <algorithm>
@@ -28,12 +28,6 @@
 #include "fuzz_support.h"
 
 namespace {
-
-// Open finding (fuzz/README.md "Findings"): at 50 µs the last tick of a move can still end a
-// fraction of a microstep past the target (the braking curve missed by a rounding error, or the
-// axis on the target at VSTOP), one count of the integer position; the axis comes back after
-// TZEROWAIT. Tolerated as one count, as for the long ticks, until it is fixed; then false again.
-constexpr bool kToleratePastTargetRounding = true;
 
 // Tick budgets of one input (fuzz/README.md, Decisions): the random phase runs at most
 // kRandomPhaseTicks, at most kTicksPerOperation after each operation; the final stop and move
@@ -295,14 +289,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   long i = 0;
   for (; i < bound && !ramp.position_reached(); ++i) {
     checker.tick(config, dt_s);
-    // No overshoot: the axis stays between start and target (wrapping arithmetic). At the
-    // drive's 50 µs exactly; with the long ticks this target also uses (1 ms, 10 ms) several
-    // bands can pass within one tick and the last one may end a fraction of a µstep beyond the
-    // target before the axis comes back: one count of the integer counter is tolerated there.
+    // No overshoot: the axis stays between start and target (wrapping arithmetic), at every tick
+    // length (the long ticks pass several bands within one tick).
     const int64_t travelled = static_cast<int32_t>(static_cast<uint32_t>(ramp.position()) - static_cast<uint32_t>(start));
-    const int64_t slack = (dt_s > 50e-6 || kToleratePastTargetRounding) ? 1 : 0;
-    FUZZ_CHECK(distance >= 0 ? (travelled >= 0 && travelled <= distance + slack)
-                             : (travelled <= 0 && travelled >= distance - slack),
+    FUZZ_CHECK(distance >= 0 ? (travelled >= 0 && travelled <= distance) : (travelled <= 0 && travelled >= distance),
                "move of %lld from %d: at %lld after %ld ticks (velocity %g)", static_cast<long long>(distance), start,
                static_cast<long long>(travelled), i, ramp.velocity());
   }

@@ -582,6 +582,33 @@ def sdo_seeds():
     tmcl_can_frame_seeds()
 
 
+# 2026-11-27: the eight_point_ramp campaign's findings (fuzz/README.md "Findings").
+EIGHT_POINT_RAMP_FINDINGS = [
+    ("finding_2026_11_27_last_q32_unit_of_a_crawl",
+     "Nvox8M76hBMhY7OWzGjwyknJHtTMWmy1KwD+asWKbC2pkuwXyqCPIWOz/////////////xUpclJdysp4AAC4pTjH4KN5c5VYBwAA"
+     "AQAAYwH5N4d0zj1nOs+8s0cdv0ncCw=="),
+    ("finding_2026_11_27_tvmax_stalls_on_a_fraction",
+     "ODGWCH2MU2KB7VYABBX8N4y6YHNCiiFroCujHwvbx1wUWO44SCUo4nmfrwotGPtS5QEcbiNiL/1WAAQV/DeMumCNvXXelF9LM9ES"
+     "yVEQj1YqOea21B3vmU5w+tcgN898////////////////wv8CAAACAAAAnEcdQEncCw=="),
+    ("finding_2026_11_27_on_the_target_with_a_residual_speed",
+     "+jHVz5pp0c9XA/P0VlqF+DEAAAAAAAAAAE30AJWH4k2/PAstAE30AJWG4v/////////xTb88Cy2gkJiTv5Myi7P1qrb755WzGcDA"
+     "////q8DAwMDAwMDAwMDAwMDAwETFp0IAAAjSKGXPs0e8QB1J3As="),
+    ("finding_2026_11_27_braking_curve_rounds_past_the_target",
+     "+jHVz5pp0c9XA/Na9IVW+DEAAAAAAKNuG+z0AJWH4k2/PAstAE30CZWG4v////////8hTb88Cy2gkJiTv5Myi7P1qrb755WzGcDA"
+     "////q8DAwMDAwMDAwMDAwMDAwETFp0IAAAjSKGXPs0e8QB1J3As="),
+]
+
+
+# 2026-11-27: 606C of a csp set-point half the counter away overflowed int32 (fuzz/README.md "Findings").
+TMCM3216_DRIVE_FINDINGS = [
+    ("finding_2026_11_27_velocity_actual_beyond_int32",
+     "/tzJQABKsgSp9C3Sv+nWU4UhencVpnMcjamMnvD35IFg++HON3Jb0VfIjl+tfSoGAgAAAAEAAQACAAEA//8AAAAAAAD/////AAAA"
+     "GgAVEiQZAAAAAIEAAACA////fwDIAAAAAAAAAMgAAADIAAAAyAAApstIET8Eu/QKjA9SGdYRUFq+0lX0SJeOZgNhZhifZS7x1W9X"
+     "P2ycDS9Ogr7G7wmDYZGfGkfHqzMnygAAx+ZZyW0yf3vk4EYJ/zPqK3V8jD81m66vh9E+ZYpESe/CrccwV6oPYULqv+q6n/VGSQlK"
+     "xpUAAMgAAADIAAA9StSF8L2NGSQSFbnSPCAKxQNyMqi7JZLnNz0U2EMf"),
+]
+
+
 def engine_seeds():
     # The ramp, homing, TMCM-3216 drive and TMCM-142 engine targets read FuzzedDataProvider input
     # too; their own generator, so that the seeds of the targets above stay as they are.
@@ -590,6 +617,11 @@ def engine_seeds():
         for target in ("eight_point_ramp", "cia402_homing", "tmcm3216_drive", "tmcm142_engine"):
             for k in range(2):
                 write(target, f"random_{n}_{k}", bytes(rng.randrange(256) for _ in range(n)))
+    # Inputs of findings, kept byte for byte: each replays its bug.
+    for name, text in EIGHT_POINT_RAMP_FINDINGS:
+        write("eight_point_ramp", name, base64.b64decode(text))
+    for name, text in TMCM3216_DRIVE_FINDINGS:
+        write("tmcm3216_drive", name, base64.b64decode(text))
     # tmcm3216_drive's last byte is its bring-up: bits 0-2 the axes enabled, 3-5 the mode
     # (pp, pv, hm, csp, csv, ...), 6 no NMT start, 7 limit switches off (2005 = 3).
     for bring_up in (0x07, 0x0F, 0x17, 0x1F, 0x27, 0x81, 0x89, 0x91, 0x99, 0xA1, 0xC7):
@@ -665,6 +697,15 @@ def text_file_seeds():
               "position_sensor": "abn_encoder", "hall_interpolation": true, "encoder_alignment": "hall",
               "brake_chopper_voltage_v": 52, "current_p": 461, "current_i": 3932, "velocity_p": 1200,
               "velocity_i": 1200, "position_p": 300},
+  "axis_parameters": {"11": 1500}
+}
+""")
+    # Finding of 2026-11-27 (fuzz/README.md "Findings"): a torque constant that gives a flux
+    # linkage outside the range the description is written back with.
+    write("motor_description", "kt_gives_flux_out_of_range", """{
+  "name": "named", "pole_pairs": 2, "torque_constant_nm_per_a": 50.35,
+  "startup": {"max_current_ma": 1999, "open_loop_current_ma": 1000, "brake_chopper_voltage_v": 52, "current_p": 1200,
+              "velocity_i": 1200, "position_p": 150},
   "axis_parameters": {"11": 1500}
 }
 """)

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/cia402/axis_drive.h"
 #include "support/cia402_axis_rig.h"
@@ -132,6 +133,23 @@ TEST(Cia402AxisObjects, CyclicSyncPositionAddsThePositionOffset) {
     EXPECT_EQ(a.drive.position_demand(), from + (cycle * 100 + 500 - from) / 2) << cycle;
     a.run_ticks(10);
     EXPECT_EQ(a.drive.position_demand(), cycle * 100 + 500) << cycle;
+  }
+}
+
+// Fuzz finding (2026-11-27): a csp set-point half the counter away, interpolated over a short
+// period, is a velocity beyond 606C's int32 (4.2e11 units); converting it was undefined behaviour.
+// 606C now saturates.
+TEST(Cia402AxisObjects, VelocityActualSaturatesBeyondInt32) {
+  for (const int32_t target : {2'000'000'000, -2'000'000'000}) {
+    Axis a;
+    a.drive.objects.interpolation_period = 1;
+    a.drive.objects.interpolation_index = -4;  // 0.1 ms: two ticks of 1e9 µsteps
+    a.enable(8);
+    a.drive.objects.target_position = target;
+    a.drive.on_sync();
+    a.run_ticks(1);
+    EXPECT_EQ(a.drive.velocity_actual_value(),
+              target > 0 ? std::numeric_limits<int32_t>::max() : std::numeric_limits<int32_t>::min());
   }
 }
 

@@ -746,5 +746,79 @@ TEST(EightPointRamp, vmax_zero_does_not_move) {
   EXPECT_FALSE(ramp.position_reached());
 }
 
+// Fuzz finding (campaign 2026-11-27): the last tick of a move ended a Q32 unit past the target,
+// one count at 50 µs. The braking curve's ticks were rounded to the nearest Q32 unit, half a unit
+// ahead of the curve at worst; near the end of the curve (a slow D1, speeds below 1 pps) that half
+// unit is worth more speed than the join allows, the "too fast" branch braked a full tick and
+// passed the target. Now the ticks round towards the start. The stops before the moves leave the
+// counter at a fraction of a microstep; the first five pairs failed before the change.
+TEST(EightPointRamp, a_move_never_passes_its_target_by_a_rounding_error) {
+  EightPointConfig c;  // the finding's profile, as the fuzz target printed it
+  c.a1_pps2 = 490781768;
+  c.v1_pps = 75294.117647058825;
+  c.a2_pps2 = 770809.75629021134;
+  c.v2_pps = 6481098.5662625171;
+  c.vmax_pps = 99.999998527355302;
+  c.amax_pps2 = 9832.5771400182803;
+  c.dmax_pps2 = 5765.8905162958781;
+  c.d2_pps2 = 133679.6875;
+  c.d1_pps2 = 5257.5908172753498;
+  ASSERT_EQ(EightPointRamp::validate(c), EightPointConfigError::kNone);
+  struct Case {
+    double stop_from_pps;
+    int distance;
+  };
+  const Case cases[] = {{19.463741722093541, 516}, {66.140244637144988, 1108}, {69.625668723979587, 813},
+                        {53.381854310952598, 127}, {3.2650774763871868, 1099}, {0.0, 1},
+                        {99.0, 2},                 {41.0, 57},                 {7.5, 300}};
+  for (const Case& test_case : cases) {
+    EightPointRamp ramp;
+    ramp.set_state(0, test_case.stop_from_pps);
+    ramp.stop();
+    for (int i = 0; i < 100000 && !ramp.standstill(); ++i) ramp.step(c, kDt);
+    ASSERT_TRUE(ramp.standstill());
+    ramp.set_position_target(ramp.position() + test_case.distance);
+    int ticks = 0;
+    for (; ticks < 400000 && !ramp.position_reached(); ++ticks) {
+      ramp.step(c, kDt);
+      ASSERT_GE(ramp.distance_to_target(), 0.0) << "stop from " << test_case.stop_from_pps << " pps, move of "
+                                                << test_case.distance << ": past the target after " << ticks
+                                                << " ticks at " << ramp.velocity() << " pps";
+    }
+    EXPECT_TRUE(ramp.position_reached()) << test_case.stop_from_pps << " " << test_case.distance;
+  }
+}
+
+
+// Fuzz finding (2026-11-27): in a long tick (10 ms) the braking of the "too fast" branch passed
+// DMAX, D2 and D1 down to VSTOP in 7 ms and went on at VSTOP for the rest of the tick, 299 µsteps
+// past the target. An axis that can brake to VSTOP before the target ends such a tick on it.
+TEST(EightPointRamp, a_long_tick_that_brakes_to_vstop_early_ends_on_the_target) {
+  EightPointConfig c;  // the finding's profile
+  c.vstart_pps = 77.538749661181868;
+  c.a1_pps2 = 724249388;
+  c.v1_pps = 118014.70588235294;
+  c.a2_pps2 = 724249388;
+  c.v2_pps = 2829099;
+  c.vmax_pps = 5027013;
+  c.amax_pps2 = 334915783;
+  c.dmax_pps2 = 334901894;
+  c.d2_pps2 = 696112742;
+  c.d1_pps2 = 38844297.275056563;
+  c.vstop_pps = 107810;
+  c.tzerowait_us = 1515520;
+  ASSERT_EQ(EightPointRamp::validate(c), EightPointConfigError::kNone);
+  EightPointRamp ramp;
+  ramp.set_position_target(-502338288);
+  int ticks = 0;
+  for (; ticks < 20000 && !ramp.position_reached(); ++ticks) {
+    ramp.step(c, 0.01);
+    ASSERT_LE(ramp.distance_to_target(), 0.0) << "past the target after " << ticks << " ticks at "
+                                              << ramp.velocity() << " pps";
+  }
+  EXPECT_TRUE(ramp.position_reached());
+  EXPECT_LT(ticks, 10000);  // arrived in one go: no overshoot, TZEROWAIT and move back
+}
+
 }  // namespace
 }  // namespace motwin::motion

@@ -19,14 +19,6 @@ inline constexpr int32_t kMax32 = std::numeric_limits<int32_t>::max();
 
 inline int32_t wrap(int64_t value) { return static_cast<int32_t>(static_cast<uint32_t>(static_cast<uint64_t>(value))); }
 inline int32_t difference(int32_t a, int32_t b) { return wrap(static_cast<int64_t>(a) - b); }
-// 6099 and 609A/6083 take the whole UNSIGNED32 range (manual tables 260, 315, 317) and the
-// module's units may scale them further: a speed or acceleration the int32 homing config cannot
-// hold runs at the largest it can (a cast would be undefined behaviour).
-inline int32_t saturate_to_int32(double value) {
-  if (value >= static_cast<double>(kMax32)) return kMax32;
-  if (value <= static_cast<double>(kMin32)) return kMin32;
-  return static_cast<int32_t>(value);
-}
 
 }  // namespace drive_detail
 
@@ -277,11 +269,11 @@ template <class Manufacturer>
 void AxisDrive<Manufacturer>::start_homing() {
   const UnitScale u = units();
   HomingConfig config;
-  config.fast_speed_pps = drive_detail::saturate_to_int32(u.velocity_pps(objects.homing_speed_fast));
-  config.slow_speed_pps = drive_detail::saturate_to_int32(u.velocity_pps(objects.homing_speed_slow));
+  config.fast_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_fast));
+  config.slow_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_slow));
   const uint32_t acceleration =
       objects.homing_acceleration != 0 ? objects.homing_acceleration : objects.profile_acceleration;
-  config.acceleration_pps2 = drive_detail::saturate_to_int32(u.acceleration_pps2(acceleration));
+  config.acceleration_pps2 = saturate_to_int32(u.acceleration_pps2(acceleration));
   config.home_offset_usteps = objects.home_offset;
   // An index method finds its pulse within one revolution; two allow for the edge's position.
   config.index_search_limit_usteps = 2 * usteps_per_revolution_;

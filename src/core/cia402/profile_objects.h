@@ -63,6 +63,15 @@ struct ProfileObjects {
   uint32_t encoder_increments = 1;                  // 608F sub 1 (per motor revolution)
 };
 
+// A double in int32 range: the largest or smallest int32 beyond it (a cast would be undefined
+// behaviour). 6099 and 609A/6083 take the whole UNSIGNED32 range (manual tables 260, 315, 317) and
+// the module's units scale values further both ways.
+inline int32_t saturate_to_int32(double value) {
+  if (value >= static_cast<double>(std::numeric_limits<int32_t>::max())) return std::numeric_limits<int32_t>::max();
+  if (value <= static_cast<double>(std::numeric_limits<int32_t>::min())) return std::numeric_limits<int32_t>::min();
+  return static_cast<int32_t>(value);
+}
+
 // Object units -> internal units: what one unit of a velocity object (6081, 60FF, 6099, ...) and
 // of an acceleration object (6083..6085, 609A) is in microsteps/s and microsteps/s². CiA-402
 // leaves the units to the drive; the module decides them (AxisDrive's module part, units()).
@@ -73,8 +82,9 @@ struct UnitScale {
 
   double velocity_pps(double value) const { return value * pps_per_velocity_unit; }
   double acceleration_pps2(double value) const { return value * pps2_per_acceleration_unit; }
-  // Internal velocity -> object units (606C), rounded towards zero.
-  int32_t velocity_value(double pps) const { return static_cast<int32_t>(pps / pps_per_velocity_unit); }
+  // Internal velocity -> object units (606C), rounded towards zero; saturated where a small unit
+  // makes a fast axis' value larger than 606C can hold (found by fuzzing: 4.2e11 units).
+  int32_t velocity_value(double pps) const { return saturate_to_int32(pps / pps_per_velocity_unit); }
 };
 
 }  // namespace motwin::cia402

@@ -182,6 +182,14 @@ Motion accelerate_within_tvmax(const EightPointConfig& config, double speed_pps,
   return best;
 }
 
+// The highest speed at the start of a tick from which an axis that reaches its target in the tick
+// comes to rest there: one tick of braking down to VSTOP (from where the ramp drops to 0; VSTART
+// <= VSTOP), with the slack of the braking-curve join.
+double arrival_speed_pps(const EightPointConfig& config, double speed_pps, double dt_s) {
+  return config.vstop_pps + deceleration_band(config, speed_pps).rate_pps2 * dt_s * (1.0 + kRelativeSlack) +
+         1e-9 * (1.0 + speed_pps);
+}
+
 bool valid_number(double value) { return value >= 0.0; }  // false for NaN too
 
 }  // namespace
@@ -282,11 +290,10 @@ void EightPointRamp::step_position(const EightPointConfig& config, double dt_s) 
     // A move starts with a jump to VSTART (never above VMAX).
     direction = sign_of(distance);
     speed = min_of(config.vstart_pps, config.vmax_pps);
-  } else if (distance == 0.0 && speed <= deceleration_band(config, speed).rate_pps2 * dt_s * (1.0 + kRelativeSlack) +
-                                            1e-9 * (1.0 + speed)) {
-    // On the target with less speed left than one tick of braking takes away (the braking curve
-    // ended the last tick exactly there): at rest here. Braking on as below would end a fraction of
-    // a microstep past the target (found by fuzzing: one count beyond at 50 µs).
+  } else if (distance == 0.0 && speed <= arrival_speed_pps(config, speed, dt_s)) {
+    // On the target at an arrival speed (the braking curve ended the last tick exactly there, or
+    // at VSTOP = VMAX): at rest here. Braking on as below would end a fraction of a microstep past
+    // the target (found by fuzzing: one count beyond at 50 µs).
     come_to_rest(config);
     return;
   } else if (direction * distance <= 0.0) {
@@ -350,19 +357,47 @@ void EightPointRamp::step_position(const EightPointConfig& config, double dt_s) 
   } else {
     tvmax_hold_s_ = 0.0;
   }
-  if (motion.speed_pps > curve_pps) {
+  const bool braking_to_target = motion.speed_pps > curve_pps;
+  if (braking_to_target) {
     if (speed - curve_pps <= join_allowance) {
-      // On the braking curve: ends the tick exactly on it.
+      // On the braking curve: ends the tick exactly on it. The curve ends at or before the target,
+      // so a distance beyond it is a rounding error (found by fuzzing: a residual 0.001 pps and one
+      // Q32 unit past the target): it stops on the target, where the next tick comes to rest.
       const Segment segment = curve_pps < speed ? deceleration_band(config, 0.5 * (speed + curve_pps)).segment
                                                 : motion.segment;
-      motion = Motion{curve_pps, 0.5 * (speed + curve_pps) * dt_s, segment};
+      motion = Motion{curve_pps, min_of(0.5 * (speed + curve_pps) * dt_s, remaining), segment};
     } else {
       // Too fast for the target (it moved closer): brake as hard as the profile allows and
       // overshoot; the axis comes back after TZEROWAIT.
       motion = decelerate(config, speed, min_of(config.vstop_pps, speed), dt_s);
     }
   }
-  advance(direction * motion.distance);
+  if (motion.distance >= remaining &&
+      (speed <= arrival_speed_pps(config, speed, dt_s) ||
+       stopping_distance(config, speed) <= remaining * (1.0 + kRelativeSlack))) {
+    // The tick reaches the target and the axis could brake to VSTOP on the way: it ends there, at
+    // rest (VSTOP drops to 0). Going on would pass the target: braked to VSTOP early in a long
+    // tick and on at VSTOP for the rest of it (found by fuzzing: 299 µsteps past at 10 ms), or a
+    // braking curve missed by a rounding error (a fraction of a microstep, one count at 50 µs).
+    // A real overshoot cannot brake in the distance left, passes and comes back.
+    position_q32_ = static_cast<uint64_t>(static_cast<uint32_t>(target_position_)) << kFractionBits;
+    come_to_rest(config);
+    segment_ = motion.speed_pps > 0.0 && motion.speed_pps < speed ? deceleration_band(config, speed).segment
+                                                                  : Segment::kRest;
+    return;
+  }
+  if (braking_to_target) {
+    // Rounded to the Q32 unit towards the start, never towards the target: the ramp stays at or
+    // behind the braking curve, so the next tick finds itself on it or below. Rounded to nearest,
+    // half a unit ahead near the end of the curve (where a unit is worth much speed) looked too
+    // fast for the target and braked past it (found by fuzzing). A tick of less than one unit is
+    // rounded to nearest: rounded down it would never cover the last unit (found by fuzzing too).
+    double units = std::floor(motion.distance * kQ32);
+    if (units == 0.0) units = std::floor(motion.distance * kQ32 + 0.5);
+    position_q32_ += static_cast<uint64_t>(static_cast<int64_t>(direction) * static_cast<int64_t>(units));
+  } else {
+    advance(direction * motion.distance);
+  }
   velocity_pps_ = direction * motion.speed_pps;
   segment_ = motion.segment;
   acceleration_pps2_ = (velocity_pps_ - start_velocity) / dt_s;
