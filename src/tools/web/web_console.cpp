@@ -15,6 +15,7 @@
 #include "core/tmcl/status.h"
 #include "tools/canopen_object_text.h"
 #include "tools/tmcl_mnemonics.h"
+#include "tools/web/web_datalogger.h"
 
 namespace motwin::tools::web {
 
@@ -575,9 +576,11 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       return send(Json{{"id", id}, {"ok", true}});
     } else if (name == "monitor") {
       error = monitor_op(request, id);
+    } else if (name == "datalogger") {
+      error = datalogger_op(request, id);
     } else {
       error = "unknown op \"" + name + "\" (list, get, set, store, restore, tmcl, sdo_read, sdo_write, nmt, "
-              "subscribe, unsubscribe, monitor)";
+              "subscribe, unsubscribe, monitor, datalogger)";
     }
     if (!error.empty()) send(Json{{"id", id}, {"ok", false}, {"error", error}});
   }
@@ -922,6 +925,34 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
                                     reply["instruction"] = format_instruction(instruction);
                                     session.send(reply);
                                   }));
+    return {};
+  }
+
+  // {"op":"datalogger","module":N,"action":...}: the module's datalogger through its TMCL
+  // service (tools/web/web_datalogger.h).
+  std::string datalogger_op(const Json& request, const Json& id) {
+    std::string error;
+    size_t index = 0;
+    const ConsoleTarget* target = console_.target_of(request, index, error);
+    if (target == nullptr) return error;
+    if (target->tmcl == nullptr) return "module " + target->name + " takes no TMCL from the console: no datalogger";
+    std::variant<DataloggerPlan, std::string> plan = parse_datalogger_request(request);
+    if (const std::string* refused = std::get_if<std::string>(&plan)) return *refused;
+    TmclPort* port = console_.port(index);
+    DataloggerLink link;
+    link.request = [port](const tmcl::Instruction& instruction, std::function<void(const DataloggerAnswer&)> done) {
+      port->request(instruction, [done = std::move(done)](const TmclAnswer& answer) {
+        done(DataloggerAnswer{answer.replied, answer.status, answer.value});
+      });
+    };
+    link.alive = [session_link = link_] { return session_link->session != nullptr; };
+    link.sim_time_us = [&console = console_] { return console.sim_time_us(); };
+    run_datalogger(std::get<DataloggerPlan>(plan), std::move(link),
+                   replying<Json>([id](Session& session, const Json& answer) {
+                     Json reply = answer;
+                     reply["id"] = id;
+                     session.send(reply);
+                   }));
     return {};
   }
 
