@@ -44,6 +44,8 @@
   window.motwinConsole = {
     get scope() { return state.scope.instance; },
     get scopeRunning() { return state.scope.running; },
+    get module() { return currentModule(); },  // for the datalogger mode (datalogger.js)
+    get rows() { return state.rows; },
   };
 
   // --- Connection --------------------------------------------------------------------------------
@@ -141,6 +143,7 @@
     state.rows = rowsOf(module);
     applyFilter();
     resetScopeChoices();
+    if (window.MotwinDatalogger) window.MotwinDatalogger.moduleChosen();
     if (state.view === "canopen") startCanopenView();
   }
 
@@ -973,6 +976,7 @@
   function showView(name) {
     if (name !== "scope") stopScope("left the Scope view");
     if (name !== "canopen") stopCanopenView();
+    if (window.MotwinDatalogger) window.MotwinDatalogger.viewShown(name);
     state.view = name;
     for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
       tab.setAttribute("aria-selected", String(tab.dataset.view === name));
