@@ -26,7 +26,7 @@ try:  # without Selenium, bh.HeadlessChromium skips the tests before any of thes
 except ImportError:  # pragma: no cover - reported as a skip
     pass
 
-RAMDEBUG, GET_SAMPLE = 142, 9
+RAMDEBUG, GET_STATE, GET_SAMPLE = 142, 8, 9
 STATUS_OK = 100
 WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 ACTUAL_VELOCITY, ACTUAL_POSITION, TORQUE_CURRENT = 42, 52, 31  # TMCM-1636 axis parameters
@@ -213,6 +213,10 @@ def test_datalogger_in_browser(motwin):
         check_equal(len(browser.datalogger("d.scope.uplot.data[0]")), 200, "samples of a repeated capture")
         browser.find("#datalogger-stop").click()
         browser.wait("the capture to stop", lambda: not browser.datalogger("d.running"))
+        # Stop is INIT, the page's last request: once its session is closed, the module's
+        # datalogger is idle (GET_STATE over TMCL/TCP).
+        browser.wait("the mode's session to close after Stop", lambda: not browser.datalogger("d.sessionOpen"))
+        check_equal(tmcl.request(RAMDEBUG, GET_STATE).value, 0, "the module's datalogger state after Stop")
 
         # Live mode again: its controls back, the datalogger's hidden.
         browser.find('input[name=scope-mode][value="live"]').click()

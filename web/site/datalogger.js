@@ -24,6 +24,8 @@
     socket: null,        // the mode's own WebSocket session
     nextId: 1,
     waiting: new Map(),
+    queue: [],           // requests not sent yet
+    inFlight: false,     // a request waits for its reply
     running: false,      // a capture is set up, armed, being read or about to repeat
     run: null,           // {channels (rows), prescaler, samples, trigger, repeat}
     pollTimer: null,
@@ -39,6 +41,7 @@
     get info() { return state.info; },
     get mode() { return state.mode; },
     get running() { return state.running; },
+    get sessionOpen() { return state.socket !== null; },
     get scope() { return state.scope; },
     get captures() { return state.captures; },
     get last() { return state.last; },
@@ -56,10 +59,13 @@
 
   // --- The mode's session -------------------------------------------------------------------------
 
+  // The mode's requests go one at a time, each after the previous one's reply: a Stop's INIT
+  // then never lands between the instructions of a start still being sent.
   function openSession() {
     if (state.socket) return;
     const socket = new WebSocket(socketUrl(), "motwin");
     state.socket = socket;
+    socket.addEventListener("open", () => { if (state.socket === socket) pump(); });
     socket.addEventListener("message", (event) => {
       if (state.socket !== socket) return;
       let message;
@@ -71,13 +77,17 @@
       const callback = state.waiting.get(message.id);
       if (callback) {
         state.waiting.delete(message.id);
+        state.inFlight = false;
         callback(message);
+        pump();
       }
     });
     socket.addEventListener("close", () => {
       if (state.socket !== socket) return;
       state.socket = null;
       state.waiting.clear();
+      state.queue = [];
+      state.inFlight = false;
       if (state.running) stopCapture("connection closed", false);
     });
   }
@@ -86,6 +96,8 @@
     const socket = state.socket;
     state.socket = null;
     state.waiting.clear();
+    state.queue = [];
+    state.inFlight = false;
     // Closing a socket still connecting makes the browser log an error: close it once open.
     if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
     else if (socket) socket.close();
@@ -93,14 +105,20 @@
 
   function ask(message, callback) {
     openSession();
-    const socket = state.socket;
-    const id = state.nextId++;
-    message.id = id;
+    message.id = state.nextId++;
     message.op = "datalogger";
     message.module = state.module.module;
-    state.waiting.set(id, callback);
-    if (socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(message));
-    else socket.addEventListener("open", () => socket.send(JSON.stringify(message)), { once: true });
+    state.queue.push({ message: message, callback: callback });
+    pump();
+  }
+
+  function pump() {
+    const socket = state.socket;
+    if (state.inFlight || state.queue.length === 0 || !socket || socket.readyState !== WebSocket.OPEN) return;
+    const next = state.queue.shift();
+    state.inFlight = true;
+    state.waiting.set(next.message.id, next.callback);
+    socket.send(JSON.stringify(next.message));
   }
 
   function replyText(reply) {
@@ -137,16 +155,13 @@
       $("scope-mode").hidden = false;
       $("datalogger-mode-label").textContent = "Datalogger (" + reply.base_rate_hz + " Hz, " + reply.channels + " channels)";
       renderSetup();
-      if (state.view !== "scope") closeSession();
+      if (!state.running) closeSession();  // opened again by Capture: a session only while one runs
     });
   }
 
   function viewShown(name) {
     state.view = name;
-    if (name !== "scope") {
-      stopCapture("left the Scope view", false);
-      closeSession();
-    }
+    if (name !== "scope") stopCapture("left the Scope view", false);
   }
 
   function setMode(mode) {
@@ -157,7 +172,7 @@
       const liveStop = $("scope-stop");
       if (liveStop && !liveStop.disabled) liveStop.click();  // one mode at a time
     } else {
-      stopCapture("live mode", false);
+      stopCapture("live mode", true);
     }
     document.querySelector("#view-scope .scope-setup").hidden = datalogger;
     $("scope-plot").hidden = datalogger;
@@ -328,6 +343,8 @@
           plot(run, read);
           if (run.repeat) return arm();
           state.running = false;
+          state.run = null;
+          closeSession();
           showNote("captured " + read.samples + " samples per channel at t = " + (read.sim_time_us / 1e6).toFixed(3) + " s");
         });
       });
@@ -361,14 +378,17 @@
     state.captures++;
   }
 
-  // Stop: INIT stops a capture still armed or running (unless the session is gone).
+  // The capture ends here: with `sendInit` (Stop, live mode) INIT stops it in the module too;
+  // otherwise (another tab, another module, the session gone) the module keeps what it was doing,
+  // as with a host that goes away. The mode's session closes (after the INIT's reply).
   function stopCapture(why, sendInit) {
     if (state.pollTimer) clearTimeout(state.pollTimer);
     state.pollTimer = null;
     const wasRunning = state.running;
     state.running = false;
     state.run = null;
-    if (wasRunning && sendInit && state.socket) ask({ action: "stop" }, () => {});
+    if (wasRunning && sendInit && state.socket) ask({ action: "stop" }, () => { if (!state.running) closeSession(); });
+    else if (!state.running) closeSession();
     if (wasRunning && state.info && $("datalogger-note")) showNote(why);
   }
 
