@@ -104,6 +104,7 @@ class Rig {
   }
   FakeConnection& other_connection() { return other_connection_; }
   host::web::WebSessionHandler& other_session() { return *other_session_; }
+  void close_session() { session_.reset(); }
   host::HostRuntime& runtime() { return *runtime_; }
 
  private:
@@ -255,6 +256,26 @@ TEST(WebDatalogger, other_requests_take_turns_during_a_read_out) {
   const Json again = rig.reply_to("read");
   ASSERT_EQ(again["ok"], true);
   EXPECT_EQ(again["values"], read["values"]);
+}
+
+// A page that closes during a read-out: the op sends nothing more, and the module goes on
+// answering the console's other sessions.
+TEST(WebDatalogger, a_session_closed_during_a_read_out_ends_it) {
+  Rig rig("tmcm-1636");
+  ASSERT_EQ(rig.datalogger({{"action", "start"}, {"channels", {{{"number", 52}}}}, {"samples", 8192}})["ok"], true);
+  rig.wait_for_state("complete");
+  rig.post(Json{{"id", "read"}, {"op", "datalogger"}, {"action", "read"}});
+  for (int step = 0; step < 50; ++step) rig.runtime().step(0);
+  ASSERT_FALSE(rig.replied("read"));
+  const uint64_t served_before = rig.runtime().service().served_request_count();
+  rig.close_session();
+  for (int step = 0; step < 2000; ++step) rig.runtime().step(0);
+  // At most the window already queued was served after the close.
+  EXPECT_LE(rig.runtime().service().served_request_count() - served_before, kDataloggerReadWindow + 1);
+  rig.other_session().on_message(Json{{"id", "gap"}, {"op", "get"}, {"number", 52}}.dump());
+  for (int step = 0; step < 2'000'000 && rig.other_connection().replies.empty(); ++step) rig.runtime().step(0);
+  ASSERT_FALSE(rig.other_connection().replies.empty());
+  EXPECT_EQ(rig.other_connection().replies[0]["ok"], true);
 }
 
 }  // namespace
