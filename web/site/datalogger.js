@@ -133,13 +133,14 @@
   function moduleChosen() {
     stopCapture("module changed", false);
     closeSession();
-    if (state.scope) {
-      state.scope.destroy();
+    const chosen = console_().module || null;
+    if (state.scope && (!chosen || !state.module || chosen.module !== state.module.module)) {
+      state.scope.destroy();  // its curves were the other module's
       state.scope = null;
     }
     state.info = null;
     state.infoAnswered = false;
-    state.module = console_().module || null;
+    state.module = chosen;
     setMode("live");
     $("scope-mode").hidden = true;
     if (!state.module || state.module.protocol !== "tmcl") return;
