@@ -54,6 +54,7 @@ for bench in "${benches[@]}"; do
     bench_tcp_roundtrip) [ $quick = 1 ] && args=(--requests 3000) ;;
     bench_module_footprint) ;;
     bench_bus_scale) [ $quick = 1 ] && args=(--quick) ;;
+    bench_web_pages) [ $quick = 1 ] && args=(--rounds 1 --seconds 1 --requests 1000) ;;
     *)
       # Google Benchmark programs; the others ignore unknown options only if they say so.
       if grep -q 'benchmark/benchmark.h' "bench/$bench.cpp"; then
@@ -198,6 +199,23 @@ for module in ("TMCM-3216", "TMCM-1636"):
                      "", f"{per_node.group(2)} % of a core"))
 if not bus.strip():
     rows.append(("one serve with 127 nodes on a bus", "n/a", "", "bench_bus_scale failed or missing"))
+
+web = text("bench_web_pages")
+web_fast = re.search(r"--speed fast.*?\n\s+no page\s+[\d.]+\s+[\d.]+\s+([\d.]+)x\n\s+(\d+) pages\s+[\d.]+\s+[\d.]+\s+([\d.]+)x"
+                     r".*?pages / no page: ([\d.]+)x", web, re.S)
+web_rtt = re.search(r"round trip over TCP.*?\n\s+no page\s+([\d.]+) us\s+([\d.]+) us\n\s+\d+ pages\s+([\d.]+) us\s+([\d.]+) us"
+                    r".*?pages / no page: ([\d.]+)x / ([\d.]+)x", web, re.S)
+if web_fast:
+    rows.append((f"TMCM-1636 (physical motor) real-time factor, --speed fast, with {web_fast.group(2)} web-console pages at "
+                 "full rate", f"{web_fast.group(3)}x", f"no page {web_fast.group(1)}x",
+                 f"{web_fast.group(4)}x (goal: at least 0.90x)"))
+if web_rtt:
+    rows.append((f"TMCL round trip over TCP with {web_fast.group(2) if web_fast else 4} web-console pages at full rate "
+                 "(median / p99)", f"{web_rtt.group(3)} / {web_rtt.group(4)} us",
+                 f"no page {web_rtt.group(1)} / {web_rtt.group(2)} us",
+                 f"{web_rtt.group(5)}x / {web_rtt.group(6)}x (goal: at most 1.10x)"))
+if not web_fast or not web_rtt:
+    rows.append(("web-console pages against none", "n/a", "", "bench_web_pages failed or missing"))
 
 sizes = text("core_size")
 total = re.search(r"^\s*(\d+)\s+(\d+)\s+(\d+)\s+\d+\s+\S+\s+\(TOTALS\)", sizes, re.M)
