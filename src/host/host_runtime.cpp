@@ -67,10 +67,11 @@ void HostRuntime::step(uint64_t max_wait_us) {
   if (service_) service_->serve_queued();
   report_output_changes();
   // Input on any descriptor (a TMCL request, a CAN frame from a socketcand or SLCAN client, a
-  // connection) means a host is talking; a served TMCL request (also one queued earlier) too.
+  // connection) means a host is talking; a served TMCL request of a host (also one queued
+  // earlier) too, but not the web console's reads of subscribed values (ChannelTraffic).
   bool host_talked = loop_.input_event_count() != input_events_before;
-  if (service_ && service_->served_request_count() != served_requests_seen_) {
-    served_requests_seen_ = service_->served_request_count();
+  if (service_ && service_->served_host_request_count() != served_requests_seen_) {
+    served_requests_seen_ = service_->served_host_request_count();
     host_talked = true;
   }
   if (host_talked) busy_poll_until_us_ = monotonic_now_us() + kBusyPollAfterRequestUs;

@@ -17,7 +17,7 @@ LinkMode TmclHostService::start_mode() const {
   return settings.available && settings.start_in_ascii_mode ? LinkMode::kAscii : LinkMode::kBinary;
 }
 
-tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t resync_gap_us) {
+tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t resync_gap_us, ChannelTraffic traffic) {
   // Skip ids still in use, or with requests or a held reply from a connection that just went.
   for (uint32_t attempt = 0; attempt <= UINT16_MAX; ++attempt) {
     const tmcl::ChannelId id = next_channel_id_;
@@ -26,7 +26,8 @@ tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t re
         (held_ && held_->channel == id)) {
       continue;
     }
-    channels_.emplace(id, Channel{&channel, start_mode(), tmcl::SerialFrameDecoder(resync_gap_us), {}, {}, false});
+    channels_.emplace(id,
+                      Channel{&channel, start_mode(), traffic, tmcl::SerialFrameDecoder(resync_gap_us), {}, {}, false});
     return id;
   }
   // 65535 simultaneous connections: the transports limit their clients far below that.
@@ -173,6 +174,10 @@ void TmclHostService::serve_queued() {
       delay_ms = response.delay_ms;
     }
     ++served_request_count_;
+    const auto served_channel = channels_.find(request.channel);
+    if (served_channel == channels_.end() || served_channel->second.traffic == ChannelTraffic::kHost) {
+      ++served_host_request_count_;
+    }
     follow_power_ups();  // command 137 powers up inside execute()
     if (!reply.bytes.empty() && delay_ms > 0) {
       // Telegram pause (GP 75): wall-clock time, like the bus turnaround it stands for.

@@ -45,6 +45,12 @@ class ReplyChannel {
 
 enum class LinkMode : uint8_t { kBinary, kAscii };
 
+// Whether a channel's served requests count as a host talking (served_host_request_count(): the
+// host runtime's busy-poll window after a request). A host over TCP or a pty sends its next
+// request within microseconds of a reply; the web console's reads of subscribed values come at
+// their period, and a page's own requests already arrive as input on a descriptor.
+enum class ChannelTraffic : uint8_t { kHost, kBackground };
+
 class TmclHostService final : public tmcl::ReplySink {
  public:
   // A connection with this many requests waiting stops being read until some are served, so
@@ -62,7 +68,8 @@ class TmclHostService final : public tmcl::ReplySink {
   // Never returns 0 (channel 0 is what the engine uses for a stored program). `resync_gap_us`:
   // a pause this long between two bytes discards a partial binary frame.
   tmcl::ChannelId open_channel(ReplyChannel& channel,
-                               uint32_t resync_gap_us = tmcl::SerialFrameDecoder::kDefaultResyncGapUs);
+                               uint32_t resync_gap_us = tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
+                               ChannelTraffic traffic = ChannelTraffic::kHost);
   // Requests already queued from this channel still run (their bytes arrived, as on a serial
   // line); their replies and any pending command 138 events of the channel are dropped.
   void close_channel(tmcl::ChannelId id);
@@ -108,6 +115,8 @@ class TmclHostService final : public tmcl::ReplySink {
   bool reply_held() const { return held_.has_value(); }
   bool reply_held_for(tmcl::ChannelId id) const { return held_ && held_->channel == id; }
   uint64_t served_request_count() const { return served_request_count_; }
+  // Served requests of kHost channels only.
+  uint64_t served_host_request_count() const { return served_host_request_count_; }
 
   // tmcl::ReplySink.
   void deliver(tmcl::ChannelId channel, const tmcl::Reply& reply) override;
@@ -120,6 +129,7 @@ class TmclHostService final : public tmcl::ReplySink {
   struct Channel {
     ReplyChannel* sink = nullptr;
     LinkMode mode = LinkMode::kBinary;
+    ChannelTraffic traffic = ChannelTraffic::kHost;
     tmcl::SerialFrameDecoder decoder;
     tmcl::AsciiLink ascii;
     std::deque<PendingByte> input;
@@ -176,6 +186,7 @@ class TmclHostService final : public tmcl::ReplySink {
   std::optional<HeldReply> held_;
   tmcl::ChannelId next_channel_id_ = 1;
   uint64_t served_request_count_ = 0;
+  uint64_t served_host_request_count_ = 0;
   uint32_t power_ups_seen_ = 0;
   bool serving_ = false;
 };

@@ -82,6 +82,40 @@ TEST(HostRuntimeBusyPoll, input_on_any_descriptor_opens_the_window_and_output_al
   EXPECT_EQ(runtime.busy_poll_until_us(), window_us);
 }
 
+// The web console's reads of subscribed values go through the TMCL service on a background
+// channel: served, they leave the window closed (an idle serve with pages open still sleeps
+// between its tick batches); a host's request on an ordinary channel opens it.
+TEST(HostRuntimeBusyPoll, requests_of_a_background_channel_do_not_open_the_window) {
+  ModuleOptions options;
+  options.log = quiet;
+  MakeModuleResult made = make_module("tmcm-1636", options);
+  ASSERT_TRUE(made) << made.error();
+  HostRuntime runtime(**made, Pacing::realtime());
+  ASSERT_TRUE(runtime.has_tmcl_service());
+  runtime.start();
+  struct Replies final : ReplyChannel {
+    void send_reply(const uint8_t*, size_t length) override { bytes += length; }
+    size_t bytes = 0;
+  } console, host;
+  TmclHostService& service = runtime.service();
+  const tmcl::ChannelId console_channel =
+      service.open_channel(console, tmcl::SerialFrameDecoder::kDefaultResyncGapUs, ChannelTraffic::kBackground);
+  const tmcl::ChannelId host_channel = service.open_channel(host);
+  const testing::Bytes gap = testing::request(6, 1, 0, 0);
+  for (int i = 0; i < 3; ++i) service.receive(console_channel, gap.data(), gap.size(), monotonic_now_us());
+  for (int step = 0; step < 100 && console.bytes < 3 * tmcl::kFrameLength; ++step) runtime.step(0);
+  EXPECT_EQ(console.bytes, 3 * tmcl::kFrameLength);
+  EXPECT_EQ(runtime.busy_poll_until_us(), 0u);
+
+  const uint64_t before_us = monotonic_now_us();
+  service.receive(host_channel, gap.data(), gap.size(), before_us);
+  for (int step = 0; step < 100 && host.bytes < tmcl::kFrameLength; ++step) runtime.step(0);
+  EXPECT_EQ(host.bytes, tmcl::kFrameLength);
+  EXPECT_GE(runtime.busy_poll_until_us(), before_us + HostRuntime::kBusyPollAfterRequestUs);
+  service.close_channel(console_channel);
+  service.close_channel(host_channel);
+}
+
 // The benchmark's set-up (bench/bench_can_roundtrip.cpp): a TMCM-3216 and a TMCM-1636 on one bus
 // in one runtime, a socketcand client. Each request opens the window; the sim time stays on the
 // tick grid and never runs ahead of the wall clock while the loop spins.

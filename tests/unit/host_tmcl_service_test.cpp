@@ -78,6 +78,22 @@ TEST_F(TmclServiceOrder, connections_take_turns_and_each_keeps_its_own_order) {
   EXPECT_EQ(service_->served_request_count(), 10u);
 }
 
+// The web console's channel (ChannelTraffic::kBackground) is served like any other, in its turn;
+// only its requests are left out of served_host_request_count(), the host runtime's sign of a
+// host talking.
+TEST_F(TmclServiceOrder, background_channels_take_their_turns_but_are_not_counted_as_host_requests) {
+  LoggingChannel host('h', log_), console('c', log_);
+  const tmcl::ChannelId ih = service_->open_channel(host);
+  const tmcl::ChannelId ic =
+      service_->open_channel(console, tmcl::SerialFrameDecoder::kDefaultResyncGapUs, ChannelTraffic::kBackground);
+  for (int32_t k = 1; k <= 3; ++k) send_sgp(ic, 0, k);
+  send_sgp(ih, 1, 7);
+  serve_all();
+  EXPECT_EQ(log_, (std::vector<std::string>{"c1", "h7", "c2", "c3"}));
+  EXPECT_EQ(service_->served_request_count(), 4u);
+  EXPECT_EQ(service_->served_host_request_count(), 1u);
+}
+
 TEST_F(TmclServiceOrder, a_connection_whose_queue_ran_dry_joins_the_end_of_the_round) {
   LoggingChannel a('a', log_), b('b', log_);
   const tmcl::ChannelId ia = service_->open_channel(a);
