@@ -26,12 +26,16 @@ using Json = nlohmann::json;
 class FakeConnection final : public host::web::WebConnection {
  public:
   void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override { latest = Json::parse(message); }
+  void send_latest(std::string message) override {
+    latest = Json::parse(message);
+    ++latest_count;
+  }
   size_t queued_bytes() const override { return queued; }
 
   size_t queued = 0;  // what the fake pretends a page left unread
   std::vector<Json> replies;
   std::optional<Json> latest;
+  size_t latest_count = 0;  // pushes handed to send_latest
 };
 
 std::unique_ptr<host::VirtualModule> make(const char* name) {
@@ -116,6 +120,12 @@ class ConsoleRig {
   }
   host::VirtualModule& module() { return *module_; }
   FakeConnection& connection() { return connection_; }
+  // Another page's session on the same console.
+  std::unique_ptr<host::web::WebSessionHandler> open_session(FakeConnection& connection) {
+    return console_->open_session(connection);
+  }
+  void step() { runtime_->step(0); }
+  uint64_t served_tmcl_requests() { return runtime_->service().served_request_count(); }
 
  private:
   std::unique_ptr<host::VirtualModule> module_;
@@ -265,6 +275,42 @@ TEST(WebConsole, subscription_pushes_batches_with_advancing_simulated_time) {
   EXPECT_GT(second["sim_time_us"].get<uint64_t>(), first["sim_time_us"].get<uint64_t>());
   EXPECT_EQ(rig.ask({{"op", "unsubscribe"}})["ok"], true);
   EXPECT_EQ(rig.ask({{"op", "subscribe"}, {"items", Json::array()}, {"rate_hz", 1000}})["ok"], false);
+}
+
+// Pages showing the same rows: their batches start on the same multiple of the period, and a
+// read of a row still waiting to be served answers every session that asks for it, so the
+// module serves one read per row and period however many pages are open; each page still gets
+// its own push, with the same simulated time and values.
+TEST(WebConsole, sessions_subscribed_to_the_same_rows_share_their_reads) {
+  ConsoleRig rig("tmcm-1636");
+  FakeConnection other_connection;
+  std::unique_ptr<host::web::WebSessionHandler> other = rig.open_session(other_connection);
+  Json items = Json::array();
+  for (int number : {0, 1, 2, 3, 4, 5, 6, 11}) items.push_back({{"kind", "axis"}, {"number", number}});
+  const Json subscribe = {{"id", 7}, {"op", "subscribe"}, {"items", items}, {"rate_hz", 50}};
+  rig.send_only(subscribe.dump());
+  other->on_message(subscribe.dump());
+  FakeConnection& first = rig.connection();
+  const auto run_until_both_have = [&](size_t pushes) {
+    for (int step = 0; step < 2'000'000 && (first.latest_count < pushes || other_connection.latest_count < pushes);
+         ++step) {
+      rig.step();
+    }
+    ASSERT_GE(first.latest_count, pushes);
+    ASSERT_GE(other_connection.latest_count, pushes);
+  };
+  // The first batch of each starts at once (not shared); from the second on they coincide.
+  run_until_both_have(3);
+  const uint64_t served_before = rig.served_tmcl_requests();
+  const size_t pushes_before = std::max(first.latest_count, other_connection.latest_count);
+  run_until_both_have(pushes_before + 5);
+  const size_t batches = std::max(first.latest_count, other_connection.latest_count) - pushes_before;
+  // One read per row and batch (one more batch may be on its way), not one per row, batch and page.
+  EXPECT_LE(rig.served_tmcl_requests() - served_before, (batches + 1) * items.size());
+  ASSERT_TRUE(first.latest && other_connection.latest);
+  EXPECT_EQ((*first.latest)["sim_time_us"], (*other_connection.latest)["sim_time_us"]);
+  EXPECT_EQ((*first.latest)["values"], (*other_connection.latest)["values"]);
+  other.reset();
 }
 
 TEST(WebConsole, too_many_waiting_requests_are_refused_not_queued) {

@@ -42,14 +42,41 @@ class TmclPort final : public host::ReplyChannel {
 
   TmclPort(host::TmclHostService& service, uint8_t module_address, EventListener on_event)
       : service_(service), module_address_(module_address), on_event_(std::move(on_event)) {
-    channel_ = service_.open_channel(*this);
+    // Background: the console's reads are no host in a request/reply exchange (its pages' own
+    // requests arrive on a descriptor and open the busy-poll window as any host input does).
+    channel_ = service_.open_channel(*this, tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
+                                     host::ChannelTraffic::kBackground);
   }
   ~TmclPort() { service_.close_channel(channel_); }
   TmclPort(const TmclPort&) = delete;
   TmclPort& operator=(const TmclPort&) = delete;
 
   void request(const tmcl::Instruction& instruction, Done done) {
-    waiting_.push_back(Pending{instruction, std::move(done)});
+    waiting_.push_back(Pending{instruction, std::move(done), false, {}});
+    feed();
+  }
+
+  // A read of a subscribed value: a read of the same parameter that is waiting and not yet served
+  // answers `done` too (its answer comes from after both asked, as fresh as a read of its own),
+  // so pages that show the same rows cost the module one read per row and period.
+  void shared_read(const tmcl::Instruction& instruction, Done done) {
+    const auto same = [&instruction](const Pending& pending) {
+      return pending.shared && pending.instruction.command == instruction.command &&
+             pending.instruction.type == instruction.type && pending.instruction.motor_bank == instruction.motor_bank;
+    };
+    if (const auto found = std::find_if(waiting_.begin(), waiting_.end(), same); found != waiting_.end()) {
+      found->sharers.push_back(std::move(done));
+      return;
+    }
+    // The first in service may have been served already, its reply held for the telegram pause.
+    if (in_service_.size() > 1) {
+      const auto found = std::find_if(in_service_.begin() + 1, in_service_.end(), same);
+      if (found != in_service_.end()) {
+        found->sharers.push_back(std::move(done));
+        return;
+      }
+    }
+    waiting_.push_back(Pending{instruction, std::move(done), true, {}});
     feed();
   }
 
@@ -69,7 +96,7 @@ class TmclPort final : public host::ReplyChannel {
     } else if (!in_service_.empty()) {
       Pending served = std::move(in_service_.front());
       in_service_.pop_front();
-      served.done(TmclAnswer{});
+      served.answer(TmclAnswer{});
     }
     feed();
   }
@@ -78,6 +105,13 @@ class TmclPort final : public host::ReplyChannel {
   struct Pending {
     tmcl::Instruction instruction;
     Done done;
+    bool shared = false;          // a shared_read()
+    std::vector<Done> sharers;    // later askers of the same read
+
+    void answer(const TmclAnswer& answer) {
+      done(answer);
+      for (const Done& sharer : sharers) sharer(answer);
+    }
   };
 
   void on_frame(const tmcl::Frame& frame) {
@@ -104,7 +138,7 @@ class TmclPort final : public host::ReplyChannel {
     Pending done = std::move(in_service_.front());
     in_service_.pop_front();
     ++replied_not_served_;
-    done.done(answer);
+    done.answer(answer);
   }
 
   // The service reads a channel's requests as its queue has room, like a client's socket.
@@ -154,10 +188,24 @@ class SdoMaster final : public host::CanBusEndpoint {
   SdoMaster& operator=(const SdoMaster&) = delete;
 
   void upload(uint8_t node, uint16_t index, uint8_t sub, Done done) {
-    enqueue(node, Transfer{index, sub, false, {}, std::move(done), false, 0, std::nullopt});
+    enqueue(node, Transfer{index, sub, false, {}, std::move(done), false, 0, std::nullopt, false, {}});
+  }
+  // An upload of a subscribed value: one of the same object waiting to begin answers `done` too
+  // (as TmclPort::shared_read), so pages that show the same objects share their SDO traffic.
+  void shared_upload(uint8_t node, uint16_t index, uint8_t sub, Done done) {
+    std::deque<Transfer>& transfers = nodes_[node];
+    // The first has begun: its request is on the bus already.
+    for (size_t i = 1; i < transfers.size(); ++i) {
+      Transfer& transfer = transfers[i];
+      if (transfer.shared && transfer.index == index && transfer.sub == sub) {
+        transfer.sharers.push_back(std::move(done));
+        return;
+      }
+    }
+    enqueue(node, Transfer{index, sub, false, {}, std::move(done), false, 0, std::nullopt, true, {}});
   }
   void download(uint8_t node, uint16_t index, uint8_t sub, std::vector<uint8_t> data, Done done) {
-    enqueue(node, Transfer{index, sub, true, std::move(data), std::move(done), false, 0, std::nullopt});
+    enqueue(node, Transfer{index, sub, true, std::move(data), std::move(done), false, 0, std::nullopt, false, {}});
   }
   void nmt(uint8_t command, uint8_t node) {
     const uint8_t bytes[2] = {command, node};
@@ -226,6 +274,8 @@ class SdoMaster final : public host::CanBusEndpoint {
     bool segmented = false;
     uint8_t toggle = 0;
     std::optional<host::EventLoop::TimerId> timer;
+    bool shared = false;        // a shared_upload()
+    std::vector<Done> sharers;  // later askers of the same upload
   };
 
   static uint32_t read_u32(const uint8_t* bytes) {
@@ -300,6 +350,7 @@ class SdoMaster final : public host::CanBusEndpoint {
     if (transfer.timer) loop_.cancel_timer(*transfer.timer);
     if (!transfers.empty()) begin(node);
     transfer.done(answer);
+    for (const Done& sharer : transfer.sharers) sharer(answer);
   }
 
   host::CanBus& bus_;
@@ -990,15 +1041,16 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
   }
 
   void schedule_batch(uint64_t due_us) {
-    timer_ = console_.loop().add_timer_at(due_us, [this, due_us] {
+    timer_ = console_.loop().add_timer_at(due_us, [this] {
       timer_.reset();
       // Batches follow the wall clock; one that is still being read makes the next one wait
       // (the page gets fewer, never stale-queued, updates).
       if (!batch_in_flight_) start_batch();
+      // The next batch at the next multiple of the period on the wall clock: sessions of the same
+      // rate (or of rates that divide each other) start their batches in the same moment, so
+      // that their reads of the same items are shared (TmclPort::shared_read).
       const uint64_t now = host::monotonic_now_us();
-      uint64_t next = due_us + period_us_;
-      if (next <= now) next = now + period_us_;
-      schedule_batch(next);
+      schedule_batch((now / period_us_ + 1) * period_us_);
     });
   }
 
@@ -1026,25 +1078,25 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
         instruction.command = item.axis ? tmcl::command::kGap : tmcl::command::kGgp;
         instruction.type = item.number;
         instruction.motor_bank = item.motor_bank;
-        console_.port(item.module)->request(instruction, [finish_one](const TmclAnswer& answer) {
+        console_.port(item.module)->shared_read(instruction, [finish_one](const TmclAnswer& answer) {
           finish_one([&answer](Json& value) {
             value["status"] = answer.status;
             if (tmcl::is_success(answer.status)) value["value"] = answer.value;
           });
         });
       } else {
-        console_.sdo()->upload(*console_.targets()[item.module].canopen_node_id, item.index, item.sub,
-                               [finish_one, item, link = link_](const SdoAnswer& answer) {
-                                 finish_one([&](Json& value) {
-                                   if (!answer.answered) {
-                                     value["error"] = answer.error;
-                                   } else if (answer.abort_code != 0) {
-                                     value["abort"] = abort_text(answer.abort_code);
-                                   } else if (link->session != nullptr) {
-                                     link->session->add_value(value, answer.data, item);
-                                   }
-                                 });
-                               });
+        console_.sdo()->shared_upload(*console_.targets()[item.module].canopen_node_id, item.index, item.sub,
+                                      [finish_one, item, link = link_](const SdoAnswer& answer) {
+                                        finish_one([&](Json& value) {
+                                          if (!answer.answered) {
+                                            value["error"] = answer.error;
+                                          } else if (answer.abort_code != 0) {
+                                            value["abort"] = abort_text(answer.abort_code);
+                                          } else if (link->session != nullptr) {
+                                            link->session->add_value(value, answer.data, item);
+                                          }
+                                        });
+                                      });
       }
     }
   }
