@@ -156,6 +156,8 @@ def test_canopen_node(motwin):
             console.ask("get", module=0, index=0x1017)  # a round trip: time passes
         else:
             raise mh.TestFailure("the node never reported operational by heartbeat")
+        check_equal(console.ask("nmt_state")["nodes"], [{"module": 0, "node_id": 1, "nmt_state": "operational"}],
+                    "nmt_state: the state without the tables")
         server.stop()
 
 

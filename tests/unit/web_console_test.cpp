@@ -151,6 +151,8 @@ TEST(WebConsole, unknown_op_and_missing_fields_are_errors_with_the_request_id) {
   Json reply = rig.ask({{"op", "fly"}});
   EXPECT_EQ(reply["ok"], false);
   EXPECT_NE(reply["error"].get<std::string>().find("unknown op \"fly\""), std::string::npos);
+  // A TMCL module is no CANopen node: no NMT state to tell.
+  EXPECT_EQ(rig.ask({{"op", "nmt_state"}})["nodes"], Json::array());
   reply = rig.ask({{"op", "get"}});
   EXPECT_NE(reply["error"].get<std::string>().find("\"number\""), std::string::npos);
   reply = rig.ask({{"op", "get"}, {"module", 3}, {"number", 1}});
@@ -374,6 +376,11 @@ TEST(WebConsole, canopen_node_objects_sdo_and_nmt) {
   EXPECT_EQ(rig.ask({{"op", "nmt"}, {"command", "start"}})["ok"], true);
   rig.run_for_us(200'000);
   EXPECT_EQ(rig.ask({{"op", "list"}})["modules"][0]["nmt_state"], "operational");
+  // The same state without the tables.
+  const Json states = rig.ask({{"op", "nmt_state"}});
+  EXPECT_EQ(states["ok"], true);
+  EXPECT_EQ(states["nodes"], Json::parse(R"([{"module": 0, "node_id": 1, "nmt_state": "operational"}])"));
+  EXPECT_FALSE(states.contains("modules"));
   EXPECT_EQ(rig.ask({{"op", "nmt"}, {"command", "jump"}})["ok"], false);
   EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 1 0"}})["ok"], false);
 }

@@ -612,6 +612,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     const std::string name = op->get<std::string>();
     std::string error;
     if (name == "list") return reply_list(id);
+    if (name == "nmt_state") return reply_nmt_state(id);
     if (name == "get" || name == "set" || name == "store" || name == "restore") {
       error = parameter_op(name, request, id);
     } else if (name == "tmcl") {
@@ -631,7 +632,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       error = datalogger_op(request, id);
     } else {
       error = "unknown op \"" + name + "\" (list, get, set, store, restore, tmcl, sdo_read, sdo_write, nmt, "
-              "subscribe, unsubscribe, monitor, datalogger)";
+              "subscribe, unsubscribe, monitor, datalogger, nmt_state)";
     }
     if (!error.empty()) send(Json{{"id", id}, {"ok", false}, {"error", error}});
   }
@@ -693,6 +694,24 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       modules.push_back(std::move(module));
     }
     send(Json{{"id", id}, {"ok", true}, {"modules", std::move(modules)}, {"sim_time_us", console_.sim_time_us()}});
+  }
+
+  // {"op":"nmt_state"}: the NMT state of each CANopen node, as `list` has it, without the tables
+  // (a page that follows the state asks for this, not for the whole `list`).
+  void reply_nmt_state(const Json& id) {
+    Json nodes = Json::array();
+    for (size_t i = 0; i < console_.targets().size(); ++i) {
+      const ConsoleTarget& target = console_.targets()[i];
+      if (!target.canopen_node_id) continue;
+      Json node = {{"module", i}, {"node_id", *target.canopen_node_id}};
+      if (console_.sdo() != nullptr) {
+        if (const std::optional<uint8_t> state = console_.sdo()->announced_state(*target.canopen_node_id)) {
+          node["nmt_state"] = std::string(nmt_state_name(*state));
+        }
+      }
+      nodes.push_back(std::move(node));
+    }
+    send(Json{{"id", id}, {"ok", true}, {"nodes", std::move(nodes)}, {"sim_time_us", console_.sim_time_us()}});
   }
 
   // An item from a request's fields, or why not.
