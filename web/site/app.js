@@ -77,6 +77,36 @@
     });
   }
 
+  // A WebSocket session of a view's own (the Scope's, the CANopen view's): `handlers.open(socket)`
+  // once open, `handlers.message(message)` with each message parsed, `handlers.close()` when it
+  // ends, each only while `isCurrent(socket)` (the view has not moved on to another session).
+  function openSession(isCurrent, handlers) {
+    const socket = new WebSocket(socketUrl(), "motwin");
+    socket.addEventListener("open", () => {
+      if (isCurrent(socket) && handlers.open) handlers.open(socket);
+    });
+    socket.addEventListener("message", (event) => {
+      if (!isCurrent(socket)) return;
+      let message;
+      try {
+        message = JSON.parse(event.data);
+      } catch (error) {
+        return;
+      }
+      handlers.message(message);
+    });
+    socket.addEventListener("close", () => {
+      if (isCurrent(socket) && handlers.close) handlers.close();
+    });
+    return socket;
+  }
+
+  function closeSession(socket) {
+    // Closing a socket still connecting makes the browser log an error: close it once open.
+    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
+    else if (socket) socket.close();
+  }
+
   function request(message, callback) {
     const id = state.nextId++;
     message.id = id;
@@ -560,30 +590,19 @@
     });
     const rate = Number($("scope-rate").value);
     const items = rows.map((row) => row.address);
-    const socket = new WebSocket(socketUrl(), "motwin");
-    scope.socket = socket;
+    scope.socket = openSession((socket) => scope.socket === socket, {
+      open: (socket) => socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: rate, items: items })),
+      message: (message) => {
+        if (message.id === 1 && !message.ok) return stopScope("refused: " + (message.error || "failed"));
+        if (message.push !== "update") return;
+        scope.updates++;
+        scope.instance.push(message.sim_time_us / 1e6, message.values.map(curveValue));
+        if (scope.updates % 10 === 1) showScopeNote();
+      },
+      close: () => stopScope("connection closed"),
+    });
     scope.running = true;
     scope.updates = 0;
-    socket.addEventListener("open", () => {
-      if (scope.socket === socket) socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: rate, items: items }));
-    });
-    socket.addEventListener("message", (event) => {
-      if (scope.socket !== socket) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      if (message.id === 1 && !message.ok) return stopScope("refused: " + (message.error || "failed"));
-      if (message.push !== "update") return;
-      scope.updates++;
-      scope.instance.push(message.sim_time_us / 1e6, message.values.map(curveValue));
-      if (scope.updates % 10 === 1) showScopeNote();
-    });
-    socket.addEventListener("close", () => {
-      if (scope.socket === socket) stopScope("connection closed");
-    });
     showScopeNote();
   }
 
@@ -600,16 +619,14 @@
     const socket = scope.socket;
     scope.socket = null;
     scope.running = false;
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
+    closeSession(socket);
     showScopeNote((why || "stopped") + "; updates: " + scope.updates);
   }
 
   // --- CANopen -----------------------------------------------------------------------------------
-  // The node's NMT state (as `list` reports what the master heard), each axis's CiA-402 words live
-  // through a session of its own (like the Scope's, so that the Parameters view's subscription
-  // stays), the error register and 1003, and the PDO mappings read by SDO.
+  // The node's NMT state (what the master heard: the small `nmt_state` op), each axis's CiA-402
+  // words live through a session of its own (like the Scope's, so that the Parameters view's
+  // subscription stays), the error register and 1003, and the PDO mappings read by SDO.
 
   const CANOPEN_VIEW_RATE_HZ = 10;
   const NMT_POLL_MS = 1000;
@@ -713,36 +730,28 @@
     canopen.monitor.frames = 0;
     canopen.monitor.dropped = 0;
     showMonitorNote();
-    const socket = new WebSocket(socketUrl(), "motwin");
-    canopen.socket = socket;
     let nextId = 2;
-    const pollNmt = () => {
-      if (canopen.socket === socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ id: nextId++, op: "list" }));
-    };
-    socket.addEventListener("open", () => {
-      if (canopen.socket !== socket) return;
-      socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: CANOPEN_VIEW_RATE_HZ, items: items.slice(0, CANOPEN_MAX_LIVE_ROWS) }));
-      socket.send(JSON.stringify({ id: 0, op: "monitor", enable: true }));
-      canopen.pollTimer = setInterval(pollNmt, NMT_POLL_MS);
-    });
-    socket.addEventListener("message", (event) => {
-      if (canopen.socket !== socket) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      if (message.push === "update") return onCanopenUpdate(message);
-      if (message.push === "frames") return onFrames(message);
-      if (message.id === 1 && !message.ok) $("canopen-note").textContent = "live values refused: " + replyText(message);
-      if (message.id > 1 && message.ok && message.modules) showNmtState(message.modules[module.module]);
-    });
-    socket.addEventListener("close", () => {
-      if (canopen.socket === socket) {
+    canopen.socket = openSession((socket) => canopen.socket === socket, {
+      open: (socket) => {
+        socket.send(JSON.stringify({ id: 1, op: "subscribe", rate_hz: CANOPEN_VIEW_RATE_HZ, items: items.slice(0, CANOPEN_MAX_LIVE_ROWS) }));
+        socket.send(JSON.stringify({ id: 0, op: "monitor", enable: true }));
+        // The NMT state by the small "nmt_state" op (not the whole "list" with every table).
+        canopen.pollTimer = setInterval(() => {
+          if (canopen.socket === socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ id: nextId++, op: "nmt_state" }));
+        }, NMT_POLL_MS);
+      },
+      message: (message) => {
+        if (message.push === "update") return onCanopenUpdate(message);
+        if (message.push === "frames") return onFrames(message);
+        if (message.id === 1 && !message.ok) $("canopen-note").textContent = "live values refused: " + replyText(message);
+        if (message.id > 1 && message.ok && message.nodes) {
+          showNmtState(message.nodes.find((node) => node.module === module.module));
+        }
+      },
+      close: () => {
         stopCanopenView();
         $("canopen-note").textContent = "live values: connection closed";
-      }
+      },
     });
     readErrors();
     readPdos();
@@ -755,9 +764,7 @@
     canopen.pollTimer = null;
     const socket = canopen.socket;
     canopen.socket = null;
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
+    closeSession(socket);
   }
 
   function renderAxes() {
