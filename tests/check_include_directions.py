@@ -13,7 +13,9 @@ The rules (docs/architecture.md, "Include directions"):
            models the hardware, not the firmware
   host/    includes no tools/ or cli/
   tools/   includes no cli/
-  cli/     may include every layer; nothing below it includes cli/
+  cli/     may include every layer but firmware/; nothing below it includes cli/
+  firmware/ (the Cortex-M images: board layer and start-up) includes only firmware/, core/,
+           board/ and types/; no other layer includes it
 
 and a module's folder in any layer (src/<layer>/modules/<module>/) includes no other module's
 folder: modules meet only in src/host/module_registry.cpp, which is not in a module folder.
@@ -28,7 +30,7 @@ import os
 import re
 import sys
 
-LAYERS = ("types", "board", "core", "sim", "host", "tools", "cli")
+LAYERS = ("types", "board", "core", "sim", "host", "tools", "cli", "firmware")
 
 # Layer -> the layers it may include (a layer not listed may not be included).
 ALLOWED = {
@@ -38,7 +40,8 @@ ALLOWED = {
     "sim": {"sim", "core", "board", "types"},
     "host": {"host", "sim", "core", "board", "types"},
     "tools": {"tools", "host", "sim", "core", "board", "types"},
-    "cli": set(LAYERS),
+    "cli": set(LAYERS) - {"firmware"},
+    "firmware": {"firmware", "core", "board", "types"},
 }
 
 SOURCE_SUFFIXES = (".h", ".hpp", ".hh", ".inl", ".ipp", ".cpp", ".cc", ".cxx")

@@ -60,7 +60,10 @@ const PdoService::ResolvedMapping& PdoService::resolve(ResolvedMapping& cache, c
       if (dictionary_.find(mapped_index(entry), mapped_sub(entry), ref) != SdoAbort::kNone) return cache;
       if (receive ? !writable(ref.info->access) : !readable(ref.info->access)) return cache;
       if (type_size(ref.info->type) * 8u != bits) return cache;
-      if (static_cast<uint64_t>(ref.row) > UINT32_MAX) return cache;  // not a row of any real table
+      // Not a row of any real table (a size_t row only exceeds 32 bits on a 64-bit host).
+      if constexpr (sizeof(ref.row) > sizeof(uint32_t)) {
+        if (ref.row > UINT32_MAX) return cache;
+      }
       cache.objects[e] = MappedObject{ref.info, static_cast<uint32_t>(ref.row), ref.index, ref.axis};
     }
     bytes += bits / 8u;

@@ -303,7 +303,7 @@ TmclModule<Derived, Axis, Globals, Io, kFacts>::program_status_rows() {
       {{128, "application status", 0, 3, 0, access("R"), Unit::kNone, "0 stop, 1 run, 2 step, 3 reset"},
        {[](Derived& m, uint8_t) { return static_cast<int32_t>(m.runtime().application_status); }, nullptr}},
       {{129, "download mode", 0, 1, 0, access("R"), Unit::kNone, "1 while the module is in download mode (command 132)"},
-       {[](Derived& m, uint8_t) { return m.runtime().download_mode ? 1 : 0; }, nullptr}},
+       {[](Derived& m, uint8_t) { return int32_t{m.runtime().download_mode ? 1 : 0}; }, nullptr}},
       {{130, "program counter", 0, kMaxU32, 0, access("R"), Unit::kNone, "TMCL program counter"},
        {[](Derived& m, uint8_t) { return static_cast<int32_t>(m.runtime().program_counter); }, nullptr}},
       {{132, "tick timer", 0, kMaxU32, 0, access("RW"), Unit::kMillisecond, "TMCL tick timer, milliseconds since power-up"},

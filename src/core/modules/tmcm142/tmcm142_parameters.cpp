@@ -187,7 +187,7 @@ const Tmcm142::Table& Tmcm142::global_parameters() {
     {{70, "CAN reply ID", 0, 2047, 2, access("RWA"), Unit::kAddress, "CAN identifier of the module's replies"}, global_field<&GlobalConfig::can_reply_id>()},
     {{71, "CAN ID", 0, 2047, 1, access("RWA"), Unit::kAddress, "CAN identifier the module listens to"}, global_field<&GlobalConfig::can_id>()},
     {{73, "EEPROM lock", 0, kUnlockCode, 0, access("RW"), Unit::kNone, "[Motwin decision] from the TMCM-351 (not in the real list): write 1234 to lock, 4321 to unlock (kept over power-up); reads 1 while locked. Locked: STAP, STGP, stored SGP and stored coordinates answer status 5"},
-     {[](Tmcm142& m, uint8_t) { return m.eeprom_locked() ? 1 : 0; },
+     {[](Tmcm142& m, uint8_t) { return int32_t{m.eeprom_locked() ? 1 : 0}; },
       [](Tmcm142& m, uint8_t, int32_t value) { return m.set_eeprom_lock(value); }}},
     {{75, "telegram pause time", 0, 255, 0, access("RWA"), Unit::kMillisecond, "Pause before a serial reply is sent"}, global_field<&GlobalConfig::telegram_pause_ms>()},
     {{76, "serial host address", 1, 255, 2, access("RWA"), Unit::kAddress, "Host address used in replies"}, global_field<&GlobalConfig::serial_host_address>()},
