@@ -11,6 +11,9 @@ packages=(
   python3 python3-serial python3-can python3-websocket socat
   chromium chromium-driver python3-selenium
   ccache clang tshark valgrind
+  # The firmware images (scripts/build-firmware.sh, docs/firmware.md): the ARM cross compiler with
+  # newlib nano and the C++ headers (the C++ library itself is not linked), and the emulator.
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-dev qemu-system-arm
 )
 missing=()
 for p in "${packages[@]}"; do
