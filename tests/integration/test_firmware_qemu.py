@@ -32,6 +32,7 @@ SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__f
 FIRMWARE_DIR = os.environ.get("MOTWIN_FIRMWARE_DIR", os.path.join(SOURCE_DIR, "build-cortex-m"))
 QEMU = "qemu-system-arm"
 BOOT_TIMEOUT = 60.0
+ENTER_ASCII = 139
 MOVE_TIMEOUT = 180.0  # 20000 counts at the default ramp take about 1 s of the board's time
 
 
@@ -174,5 +175,31 @@ def test_stap_survives_a_board_reset(motwin):
         check_equal(client.gap(43), 2345, "GAP 43 after a second STAP and reset")
 
 
+def test_tmcm142_moves_and_speaks_ascii(motwin):
+    image = firmware_image("tmcm142")
+    with TempDir() as state, EmulatedBoard(image, state) as board:
+        client = board.client
+        check_equal(client.version_string(), b"142V1.06", "TMCM-142 command 136 type 0")
+        expect_reply(client.request(MVP, MVP_ABS, 0, 5000), MVP, STATUS_OK, what="MVP ABS 5000")
+        client.wait_for("GAP 8 (position reached)", lambda: client.gap(8) == 1, MOVE_TIMEOUT, interval=0.05)
+        check_equal(client.gap(1), 5000, "GAP 1 (actual position, microsteps)")
+        # Command 139: the binary reply, then ASCII lines (docs/ascii-mode.md); BIN goes back.
+        expect_reply(client.request(ENTER_ASCII, 0), ENTER_ASCII, STATUS_OK, what="command 139")
+        client.send_raw(b"AGAP 1, 0\r")
+        text = b""
+        deadline = time.monotonic() + 30.0
+        while b"BA 100 5000\r" not in text and time.monotonic() < deadline:
+            text += client.read_available(0.5)
+        check(b"BA 100 5000\r" in text, f"ASCII GAP 1: {text!r}")
+        client.send_raw(b"ABIN\r")
+        after_bin = b""  # the echo of the line, then its reply "BA 100 ...\r"
+        while not (b"BA 100 " in after_bin and after_bin.endswith(b"\r")):
+            more = client.read_available(5.0)
+            check(more != b"", f"no reply to BIN: {after_bin!r}")
+            after_bin += more
+        check_equal(client.gap(1), 5000, "binary GAP 1 after BIN")
+
+
 if __name__ == "__main__":
-    run_tests([test_version_and_parameters, test_mvp_reaches_target, test_stap_survives_a_board_reset])
+    run_tests([test_version_and_parameters, test_mvp_reaches_target, test_stap_survives_a_board_reset,
+               test_tmcm142_moves_and_speaks_ascii])

@@ -9,8 +9,7 @@
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
 #include "firmware/banked_nvm.h"
 #include "firmware/mps2_an386/cmsdk_uart.h"
-#include "firmware/mps2_an386/system_tick.h"
-#include "firmware/serial_tmcl_link.h"
+#include "firmware/mps2_an386/tmcl_main_loop.h"
 
 namespace {
 
@@ -49,32 +48,9 @@ an386::Uart0Output g_uart;
 }  // namespace
 
 extern "C" [[noreturn]] void firmware_main() {
-  constexpr uint32_t kBaud = 115200;  // GP 65 code 7, the module's default
-  an386::uart0_init(kBaud);
+  an386::uart0_init(an386::kDefaultBaud);
   g_eeprom.open([](uint8_t* image, size_t size) { Tmcm1636::format_factory_image(image, size); });
   // Constructed once the image is open: the module reads it at power-up.
   static Tmcm1636 module(g_eeprom, g_io);
-  module.engine().power_up();
-  static firmware::SerialTmclLink link(module.engine(), g_uart);
-
-  an386::system_tick_start(Tmcm1636::kControlTickUs);
-  uint32_t ticks_run = 0;
-  for (;;) {
-    // Every SysTick since the last pass is one control tick: a slow pass catches up.
-    while (ticks_run != an386::system_tick_count()) {
-      module.tick();
-      ++ticks_run;
-    }
-    const uint64_t now_us = module.tick_count() * Tmcm1636::kControlTickUs;
-    an386::ReceivedByte received;
-    while (an386::uart0_peek(received)) {
-      if (!link.receive(received.byte, uint64_t{received.tick} * Tmcm1636::kControlTickUs)) break;
-      an386::uart0_drop();
-    }
-    link.poll(now_us);
-    an386::sleep_unless([&] {
-      an386::ReceivedByte next;
-      return ticks_run != an386::system_tick_count() || (!link.holding_reply() && an386::uart0_peek(next));
-    });
-  }
+  an386::run_tmcl_module(module, g_uart);
 }
