@@ -6,7 +6,10 @@ the host tools talk to it as to a module on a serial line (docs/firmware.md).
 - the version string and number (command 136), SAP/GAP, `motwin tmcl` unchanged against it;
 - an MVP on the ideal motor reaching its target (GAP 55 polled until set: the board's own time);
 - STAP kept over a reset of the emulated board (the monitor's system_reset: the EEPROM region is
-  outside the image, so it keeps its contents), the RAM value lost.
+  outside the image, so it keeps its contents), the RAM value lost;
+- a program downloaded and started with `motwin download`/`start`, and started again by itself
+  after a reset (stored in the EEPROM image, GP 77);
+- the TMCM-142 image: an MVP, and a GAP as an ASCII line after command 139.
 
 Skipped, visibly (exit status 77), when qemu-system-arm is not installed, or when the ARM
 toolchain is not installed and so no image was built. With the toolchain installed a missing
@@ -24,7 +27,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from motwin_harness import (  # noqa: E402
-    BANK_GLOBAL, GAP, GET_VERSION, MVP, MVP_ABS, SAP, STATUS_OK, STATUS_WRONG_TYPE, VERSION_BINARY, VERSION_STRING,
+    BANK_GLOBAL, BANK_USER, GAP, GET_VERSION, MVP, MVP_ABS, SAP, STATUS_OK, STATUS_WRONG_TYPE, VERSION_BINARY, VERSION_STRING,
     Skipped, TcpClient, TempDir, TestFailure, _die_with_parent, check, check_equal, expect_reply, run_tests,
 )
 
@@ -175,6 +178,27 @@ def test_stap_survives_a_board_reset(motwin):
         check_equal(client.gap(43), 2345, "GAP 43 after a second STAP and reset")
 
 
+def test_stored_program_runs_and_autostarts_after_a_reset(motwin):
+    """`motwin download` and `motwin start` unchanged; the program is in the EEPROM image, so after
+    a board reset it starts by itself (GP 77 = 1, the factory default) and runs again."""
+    image = firmware_image("tmcm1636")
+    program = os.path.join(SOURCE_DIR, "tests", "programs", "manual_6_4_variables.tmc")  # user variable 42 ends at 2468
+    with TempDir() as state, EmulatedBoard(image, state) as board:
+        client = board.client
+        client.sock.close()  # one client at a time on qemu's socket
+        endpoint = f"127.0.0.1:{board.port}"
+        for args in (["download", program], ["start"]):
+            result = subprocess.run([motwin, *args, "--tcp", endpoint], capture_output=True, text=True, timeout=120)
+            check(result.returncode == 0, f"motwin {args[0]}: {result.returncode} {result.stdout!r} {result.stderr!r}")
+        client = board.client = TcpClient(board.port)
+        client.wait_for("user variable 42 = 2468", lambda: client.ggp(42, BANK_USER) == 2468, MOVE_TIMEOUT)
+        client.sgp(42, BANK_USER, 0)
+        board.monitor("system_reset")
+        wait_until_answering(client)
+        client.wait_for("user variable 42 = 2468 after the reset", lambda: client.ggp(42, BANK_USER) == 2468,
+                        MOVE_TIMEOUT)
+
+
 def test_tmcm142_moves_and_speaks_ascii(motwin):
     image = firmware_image("tmcm142")
     with TempDir() as state, EmulatedBoard(image, state) as board:
@@ -202,4 +226,4 @@ def test_tmcm142_moves_and_speaks_ascii(motwin):
 
 if __name__ == "__main__":
     run_tests([test_version_and_parameters, test_mvp_reaches_target, test_stap_survives_a_board_reset,
-               test_tmcm142_moves_and_speaks_ascii])
+               test_stored_program_runs_and_autostarts_after_a_reset, test_tmcm142_moves_and_speaks_ascii])
