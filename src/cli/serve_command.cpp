@@ -501,6 +501,9 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
                                                    std::string(single.firmware_version()),
                                                    configured_node_id(module.options.node_id)));
     }
+    targets.back().world = {&served.module->signals(), [&runtime](std::string_view signal, double value) {
+                              return runtime.set_input_now(signal, value);
+                            }};
   } else {
     for (size_t i = 0; i < module.nodes.size(); ++i) {
       const host::NodeSpec& spec = module.nodes[i];
@@ -511,6 +514,7 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
                             ? tools::web::canopen_target(descriptor, member.name, firmware,
                                                          configured_node_id(spec.node_id))
                             : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware, nullptr));
+      targets.back().world.board = &member.module->signals();  // read only: a node takes no scenario
     }
   }
   auto web = std::make_unique<WebEndpoint>();

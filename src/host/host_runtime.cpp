@@ -25,6 +25,16 @@ void HostRuntime::set_scenario(std::vector<sim::ScenarioEvent> events) {
   scenario_.emplace(std::move(events), module_.signals());
 }
 
+Result<void> HostRuntime::set_input_now(std::string_view signal, double value) {
+  Result<sim::ScenarioEvent> event =
+      sim::make_scenario_event(module_.signals().input_signals(), signal, value, sim_time_us());
+  if (!event) return Error{event.error()};
+  if (!scenario_) scenario_.emplace(std::vector<sim::ScenarioEvent>{}, module_.signals());
+  scenario_->insert(std::move(*event));
+  scenario_->apply_due(sim_time_us());
+  return {};
+}
+
 void HostRuntime::start() {
   if (scenario_) scenario_->apply_due(sim_time_us());
   pacer_.start(monotonic_now_us(), sim_time_us());

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "host/event_loop.h"
@@ -43,6 +44,11 @@ class HostRuntime {
   // Events are applied to module().signals() at their sim times.
   void set_scenario(std::vector<sim::ScenarioEvent> events);
   const sim::ScenarioPlayer* scenario() const { return scenario_ ? &*scenario_ : nullptr; }
+  // Sets an input signal now, as a scenario event at the present simulated time: checked by
+  // sim::make_scenario_event() (an error names an unknown signal or the accepted range, and
+  // changes nothing), then applied by the scenario player before the next tick. The web
+  // console's World view sets signals through it.
+  Result<void> set_input_now(std::string_view signal, double value);
   // Called for every output change, in order, after the tick batch or request that caused it.
   void set_output_listener(OutputListener listener) { output_listener_ = std::move(listener); }
 

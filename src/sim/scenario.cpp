@@ -28,6 +28,16 @@ std::vector<std::string_view> split_fields(std::string_view line) {
 
 }  // namespace
 
+Result<ScenarioEvent> make_scenario_event(std::span<const SignalInfo> signals, std::string_view signal_name, double value,
+                                          uint64_t time_us, size_t line) {
+  const SignalInfo* signal = find_signal(signals, signal_name);
+  if (signal == nullptr) {
+    return Error{"unknown signal \"" + std::string(signal_name) + "\" (expected one of " + signal_names(signals) + ")"};
+  }
+  if (const Result<void> acceptable = check_signal_value(*signal, value); !acceptable) return Error{acceptable.error()};
+  return ScenarioEvent{time_us, std::string(signal->name), value, line};
+}
+
 Result<std::vector<ScenarioEvent>> parse_scenario(std::string_view text, std::string_view source_name,
                                                   std::span<const SignalInfo> signals) {
   std::vector<ScenarioEvent> events;
@@ -54,19 +64,16 @@ Result<std::vector<ScenarioEvent>> parse_scenario(std::string_view text, std::st
     if (*time_s < 0) return fail("expected a time >= 0 s, got " + std::string(fields[0]));
     if (*time_s > kMaxScenarioTimeS) return fail("time " + std::string(fields[0]) + " s is too large");
     const SignalInfo* signal = find_signal(signals, fields[1]);
-    if (signal == nullptr) {
-      return fail("unknown signal \"" + std::string(fields[1]) + "\" (expected one of " + signal_names(signals) + ")");
-    }
     const std::optional<double> value = parse_number(fields[2]);
-    if (!value) {
+    // An unknown signal, or a value out of its range, make_scenario_event() names.
+    if (signal != nullptr && !value) {
       return fail("expected a number as the value of " + std::string(signal->name) + ", got \"" +
                   std::string(fields[2]) + "\"");
     }
-    if (const Result<void> acceptable = check_signal_value(*signal, *value); !acceptable) {
-      return fail(acceptable.error() + ", got " + std::string(fields[2]));
-    }
-    events.push_back(ScenarioEvent{static_cast<uint64_t>(std::llround(*time_s * 1e6)), std::string(signal->name),
-                                   *value, line_number});
+    Result<ScenarioEvent> event = make_scenario_event(
+        signals, fields[1], value.value_or(0), static_cast<uint64_t>(std::llround(*time_s * 1e6)), line_number);
+    if (!event) return fail(event.error() + (signal != nullptr ? ", got " + std::string(fields[2]) : ""));
+    events.push_back(std::move(*event));
   }
   std::stable_sort(events.begin(), events.end(),
                    [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.time_us < b.time_us; });
@@ -98,6 +105,16 @@ ScenarioPlayer::ScenarioPlayer(std::vector<ScenarioEvent> events, SignalBoard& b
   // Callers normally pass parse_scenario() output; keep the invariant even if they do not.
   std::stable_sort(events_.begin(), events_.end(),
                    [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.time_us < b.time_us; });
+}
+
+void ScenarioPlayer::insert(ScenarioEvent event) {
+  // Events set live (the web console) would otherwise pile up: the applied ones go.
+  events_.erase(events_.begin(), events_.begin() + static_cast<std::ptrdiff_t>(next_));
+  applied_before_ += next_;
+  next_ = 0;
+  const auto after = std::upper_bound(events_.begin() + static_cast<std::ptrdiff_t>(next_), events_.end(), event,
+                                      [](const ScenarioEvent& a, const ScenarioEvent& b) { return a.time_us < b.time_us; });
+  events_.insert(after, std::move(event));
 }
 
 size_t ScenarioPlayer::apply_due(uint64_t sim_time_us) {

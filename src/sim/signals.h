@@ -21,6 +21,7 @@ struct SignalInfo {
   double max;
   bool whole_numbers_only;       // levels and raw ADC counts
   std::string_view description;  // for help text, e.g. "supply voltage in volts"
+  std::string_view unit = {};    // of an analog quantity ("V", "N m", "rev"); empty for levels and counts
 };
 
 // An output that changed, stamped with the simulated time of the change.

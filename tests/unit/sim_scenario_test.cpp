@@ -95,5 +95,27 @@ TEST(ScenarioPlayer, applies_events_when_their_time_is_reached) {
   EXPECT_EQ(player.next_event_time_us(), std::nullopt);
 }
 
+// An event made now (the web console's World view) goes in before the file's later events and
+// after the ones of its time; applied events are dropped, still counted.
+TEST(ScenarioPlayer, an_inserted_event_applies_in_time_order_among_the_files) {
+  Tmcm1636SimIo io;
+  const Result<std::vector<ScenarioEvent>> parsed = parse("0.5 GPI0 1\n1 GPI0 0\n");
+  ASSERT_TRUE(parsed.ok());
+  ScenarioPlayer player(*parsed, io);
+  EXPECT_EQ(player.apply_due(500'000), 1u);
+  const Result<ScenarioEvent> live = make_scenario_event(Tmcm1636SimIo::signal_table(), "vsupply", 30, 600'000);
+  ASSERT_TRUE(live.ok()) << live.error();
+  EXPECT_EQ(live->signal, "VSUPPLY");
+  player.insert(*live);
+  EXPECT_EQ(player.next_event_time_us(), 600'000u);
+  EXPECT_EQ(player.apply_due(600'000), 1u);
+  EXPECT_EQ(io.supply_millivolt(), 30000);
+  EXPECT_EQ(player.applied_count(), 2u);
+  EXPECT_EQ(player.next_event_time_us(), 1'000'000u);
+  EXPECT_FALSE(make_scenario_event(Tmcm1636SimIo::signal_table(), "VSUPPLY", 101, 0).ok());
+  EXPECT_EQ(make_scenario_event(Tmcm1636SimIo::signal_table(), "NOPE", 1, 0).error().find("unknown signal \"NOPE\""),
+            0u);
+}
+
 }  // namespace
 }  // namespace motwin::sim

@@ -630,9 +630,11 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       error = monitor_op(request, id);
     } else if (name == "datalogger") {
       error = datalogger_op(request, id);
+    } else if (is_world_op(name)) {
+      error = world_request(name, request, id);
     } else {
       error = "unknown op \"" + name + "\" (list, get, set, store, restore, tmcl, sdo_read, sdo_write, nmt, "
-              "subscribe, unsubscribe, monitor, datalogger, nmt_state)";
+              "subscribe, unsubscribe, monitor, datalogger, nmt_state, world, world_set)";
     }
     if (!error.empty()) send(Json{{"id", id}, {"ok", false}, {"error", error}});
   }
@@ -1125,6 +1127,19 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     if (batch.generation != generation_) return;
     connection_.send_latest(
         Json{{"push", "update"}, {"sim_time_us", batch.sim_time_us}, {"values", batch.values}}.dump());
+  }
+
+  // "world" and "world_set" (tools/web/world_ops.h) on the module the request names.
+  std::string world_request(const std::string& op, const Json& request, const Json& id) {
+    std::string error;
+    size_t index = 0;
+    const ConsoleTarget* target = console_.target_of(request, index, error);
+    if (target == nullptr) return error;
+    Result<Json> reply = world_op(op, request, index, target->world, console_.sim_time_us());
+    if (!reply) return reply.error();
+    reply->emplace("id", id);
+    send(*reply);
+    return {};
   }
 
   // {"op":"monitor","enable":true|false}: "frames" pushes of the bus's frames, or none.

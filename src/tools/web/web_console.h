@@ -22,6 +22,7 @@
 #include "host/module_listing.h"
 #include "host/tmcl_host_service.h"
 #include "host/web/web_server.h"
+#include "tools/web/world_ops.h"
 
 namespace motwin::tools::web {
 
@@ -35,6 +36,7 @@ struct ConsoleTarget {
   host::TmclHostService* tmcl = nullptr;  // a TMCL module served directly
   uint8_t module_address = 1;             // of its TMCL requests
   std::optional<uint8_t> canopen_node_id;  // a CANopen node on the bus
+  ConsoleWorld world;                      // its simulated world (ops "world", "world_set")
 };
 
 class WebConsole {

@@ -15,10 +15,10 @@ constexpr SignalInfo kSignals[] = {
     {"IN6", 0, 1, true, "digital input level"},
     {"IN7", 0, 1, true, "digital input level as the firmware reads it (opto-isolated)"},
     {"IN8", 0, 1, true, "digital input level as the firmware reads it (opto-isolated)"},
-    {"AIN0", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN0_A/D"},
-    {"AIN1", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN1_A/D"},
-    {"AIN2", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN2_A/D"},
-    {"VSUPPLY", 0, 80, false, "motor supply voltage in volts (the TMCM-142 takes 15..75 V)"},
+    {"AIN0", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN0_A/D", "counts"},
+    {"AIN1", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN1_A/D", "counts"},
+    {"AIN2", 0, Tmcm142SimIo::kAdcMax, true, "raw 12-bit ADC count of IN2_A/D", "counts"},
+    {"VSUPPLY", 0, 80, false, "motor supply voltage in volts (the TMCM-142 takes 15..75 V)", "V"},
 };
 
 size_t index_of(const SignalInfo* signal) { return static_cast<size_t>(signal - kSignals); }

@@ -8,12 +8,12 @@ namespace {
 using board::ReferenceSwitch;
 
 constexpr SignalInfo kMotorSignals[] = {
-    {"LOAD_TORQUE", -1000, 1000, false, "load torque in N m against forward rotation (physical motor)"},
-    {"LOAD_INERTIA", 0, 100, false, "inertia coupled to the rotor in kg m^2 (physical motor)"},
+    {"LOAD_TORQUE", -1000, 1000, false, "load torque in N m against forward rotation (physical motor)", "N m"},
+    {"LOAD_INERTIA", 0, 100, false, "inertia coupled to the rotor in kg m^2 (physical motor)", "kg m²"},
     {"BLOCKED", 0, 1, true, "1 blocks the rotor: an obstacle (physical motor)"},
-    {"REF_R_AT", -1e6, 1e6, false, "right switch active at rotor positions >= this, revolutions (physical motor)"},
-    {"REF_L_AT", -1e6, 1e6, false, "left switch active at rotor positions <= this, revolutions (physical motor)"},
-    {"REF_H_AT", -1e6, 1e6, false, "home switch active at rotor positions >= this, revolutions (physical motor)"},
+    {"REF_R_AT", -1e6, 1e6, false, "right switch active at rotor positions >= this, revolutions (physical motor)", "rev"},
+    {"REF_L_AT", -1e6, 1e6, false, "left switch active at rotor positions <= this, revolutions (physical motor)", "rev"},
+    {"REF_H_AT", -1e6, 1e6, false, "home switch active at rotor positions >= this, revolutions (physical motor)", "rev"},
     {"REF_AT_LEVEL", 0, 1, true, "input level of a REF_*_AT switch while the rotor is past it, the other elsewhere (default 1)"},
     {"ENCODER_FAULT", 0, 1, true, "1 freezes the ABN encoder: lost A/B/N signals (physical motor)"},
     {"HALL_FAULT", 0, 1, true, "1 makes the hall inputs read 000: lost hall supply (physical motor)"},

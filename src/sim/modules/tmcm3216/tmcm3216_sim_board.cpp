@@ -12,9 +12,9 @@ constexpr SignalInfo kDeviceSignals[] = {
     {"DIO1", 0, 1, true, "level driven onto DIO1 from outside"},
     {"DIO2", 0, 1, true, "level driven onto DIO2 from outside"},
     {"DIO3", 0, 1, true, "level driven onto DIO3 from outside"},
-    {"AIN0", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 0 (270E sub 1)"},
-    {"AIN1", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 1 (270E sub 2)"},
-    {"VSUPPLY", 0, 60, false, "motor supply voltage in volts (below 8 V the drivers flag undervoltage)"},
+    {"AIN0", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 0 (270E sub 1)", "counts"},
+    {"AIN1", 0, Tmcm3216SimBoard::kAdcMax, true, "raw 12-bit ADC count of analog input 1 (270E sub 2)", "counts"},
+    {"VSUPPLY", 0, 60, false, "motor supply voltage in volts (below 8 V the drivers flag undervoltage)", "V"},
     {"ENABLE", 0, 1, true,
      "enable signal of the shutdown switch, default 1; 0: all drivers off, EMCY 5441, every axis to FAULT"},
 };
@@ -28,32 +28,34 @@ struct AxisSignalInfo {
   double max;
   bool whole;
   std::string_view description;
+  std::string_view unit = {};
 };
 constexpr AxisSignalInfo kAxisSignals[] = {
-    {"LOAD_TORQUE", -100, 100, false, "load torque in N m against forward rotation (physical motor)"},
-    {"LOAD_INERTIA", 0, 10, false, "inertia coupled to the rotor in kg m^2 (physical motor)"},
+    {"LOAD_TORQUE", -100, 100, false, "load torque in N m against forward rotation (physical motor)", "N m"},
+    {"LOAD_INERTIA", 0, 10, false, "inertia coupled to the rotor in kg m^2 (physical motor)", "kg m²"},
     {"BLOCKED", 0, 1, true, "1 blocks the rotor: an obstacle, steps are lost (physical motor)"},
     {"REF_R", 0, 1, true, "right limit switch level, 1 = high (releases REF_R_AT/FROM/TO)"},
     {"REF_L", 0, 1, true, "left limit switch level, 1 = high"},
     {"REF_H", 0, 1, true, "home switch level, 1 = high"},
-    {"REF_R_AT", -1e6, 1e6, false, "right switch high at rotor positions >= this, revolutions"},
-    {"REF_L_AT", -1e6, 1e6, false, "left switch high at rotor positions <= this, revolutions"},
-    {"REF_H_AT", -1e6, 1e6, false, "home switch high at rotor positions >= this, revolutions"},
-    {"REF_R_FROM", -1e6, 1e6, false, "right switch window: high from this rotor position on, revolutions"},
-    {"REF_R_TO", -1e6, 1e6, false, "right switch window: high up to this rotor position, revolutions"},
-    {"REF_L_FROM", -1e6, 1e6, false, "left switch window: high from this rotor position on, revolutions"},
-    {"REF_L_TO", -1e6, 1e6, false, "left switch window: high up to this rotor position, revolutions"},
-    {"REF_H_FROM", -1e6, 1e6, false, "home switch window (a cam): high from this position on, revolutions"},
-    {"REF_H_TO", -1e6, 1e6, false, "home switch window: high up to this position, revolutions"},
-    {"ENCODER_CPR", 0, 1e6, true, "encoder quadrature counts per revolution, 0 = no encoder (default 4000)"},
+    {"REF_R_AT", -1e6, 1e6, false, "right switch high at rotor positions >= this, revolutions", "rev"},
+    {"REF_L_AT", -1e6, 1e6, false, "left switch high at rotor positions <= this, revolutions", "rev"},
+    {"REF_H_AT", -1e6, 1e6, false, "home switch high at rotor positions >= this, revolutions", "rev"},
+    {"REF_R_FROM", -1e6, 1e6, false, "right switch window: high from this rotor position on, revolutions", "rev"},
+    {"REF_R_TO", -1e6, 1e6, false, "right switch window: high up to this rotor position, revolutions", "rev"},
+    {"REF_L_FROM", -1e6, 1e6, false, "left switch window: high from this rotor position on, revolutions", "rev"},
+    {"REF_L_TO", -1e6, 1e6, false, "left switch window: high up to this rotor position, revolutions", "rev"},
+    {"REF_H_FROM", -1e6, 1e6, false, "home switch window (a cam): high from this position on, revolutions", "rev"},
+    {"REF_H_TO", -1e6, 1e6, false, "home switch window: high up to this position, revolutions", "rev"},
+    {"ENCODER_CPR", 0, 1e6, true, "encoder quadrature counts per revolution, 0 = no encoder (default 4000)",
+     "counts/rev"},
     {"ENCODER_REVERSED", 0, 1, true, "1: the encoder counts down for forward rotation"},
-    {"ENCODER_INDEX_AT", 0, 0.999999, false, "rotor angle of the N pulse within a revolution, revolutions"},
+    {"ENCODER_INDEX_AT", 0, 0.999999, false, "rotor angle of the N pulse within a revolution, revolutions", "rev"},
     {"ENCODER_INDEX_ACTIVE_LOW", 0, 1, true, "1: the N channel is active low (200B sub 1 must match)"},
     {"ENCODER_FAULT", 0, 1, true, "1 freezes the encoder counter: lost A/B/N signals"},
     {"OPEN_COIL_A", 0, 1, true, "1: coil A is open (no current; the driver flags open load A)"},
     {"OPEN_COIL_B", 0, 1, true, "1: coil B is open"},
     {"SHORT", 0, 1, true, "1: a motor lead is shorted (the driver switches its bridges off, flags overcurrent)"},
-    {"DRIVER_TEMP", -40, 200, false, "driver chip temperature in degrees C (120: pre-warning, 150: shutdown)"},
+    {"DRIVER_TEMP", -40, 200, false, "driver chip temperature in degrees C (120: pre-warning, 150: shutdown)", "°C"},
     {"BRAKE", 0, 1, true, "1: a holding brake is fitted; it holds the rotor unless its output carries current"},
 };
 enum AxisSignal : size_t {
@@ -115,7 +117,8 @@ std::span<const SignalInfo> Tmcm3216SimBoard::signal_table() {
     for (uint8_t axis = 0; axis < kAxisCount; ++axis) {
       for (size_t i = 0; i < kAxisSignalCount; ++i) {
         const AxisSignalInfo& info = kAxisSignals[i];
-        all.push_back(SignalInfo{names[axis * kAxisSignalCount + i], info.min, info.max, info.whole, info.description});
+        all.push_back(
+            SignalInfo{names[axis * kAxisSignalCount + i], info.min, info.max, info.whole, info.description, info.unit});
       }
     }
     return all;
