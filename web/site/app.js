@@ -175,6 +175,7 @@
     resetScopeChoices();
     if (window.MotwinDatalogger) window.MotwinDatalogger.moduleChosen();
     if (state.view === "canopen") startCanopenView();
+    if (state.view === "world") window.MotwinWorld.start(state.module, socketUrl());
   }
 
   // One table row per parameter or object entry, with the fields a request needs.
@@ -984,6 +985,7 @@
     if (name !== "scope") stopScope("left the Scope view");
     if (name !== "canopen") stopCanopenView();
     if (window.MotwinDatalogger) window.MotwinDatalogger.viewShown(name);
+    if (name !== "world") window.MotwinWorld.stop();
     state.view = name;
     for (const tab of document.querySelectorAll("#tabs [role=tab]")) {
       tab.setAttribute("aria-selected", String(tab.dataset.view === name));
@@ -991,6 +993,7 @@
     for (const view of document.querySelectorAll(".view")) view.hidden = view.id !== "view-" + name;
     if (name === "console") $("console-input").focus();
     if (name === "canopen") startCanopenView();
+    if (name === "world") window.MotwinWorld.start(state.module, socketUrl());
   }
 
   function start() {
