@@ -24,8 +24,10 @@ std::vector<std::string> axis_prefixes(std::span<const sim::SignalInfo> signals)
   std::vector<std::string> prefixes;
   for (const sim::SignalInfo& signal : signals) {
     const std::string_view name = signal.name;
-    if (name.size() >= kAxisMarker.size() && sim::same_signal_name(name.substr(name.size() - kAxisMarker.size()), kAxisMarker)) {
-      prefixes.emplace_back(name.substr(0, name.size() - kAxisMarker.size()));
+    if (name.size() < kAxisMarker.size()) continue;
+    const size_t prefix_length = name.size() - kAxisMarker.size();
+    if (sim::same_signal_name(name.substr(prefix_length), kAxisMarker)) {
+      prefixes.emplace_back(name.substr(0, prefix_length));
     }
   }
   return prefixes;
@@ -46,7 +48,9 @@ Json axes_json(const sim::SignalBoard& board) {
 
 Result<Json> read_world(const Json& request, size_t module, const ConsoleWorld& world, uint64_t sim_time_us) {
   const auto values_only = request.find("values_only");
-  if (values_only != request.end() && !values_only->is_boolean()) return Error{"\"values_only\": expected true or false"};
+  if (values_only != request.end() && !values_only->is_boolean()) {
+    return Error{"\"values_only\": expected true or false"};
+  }
   const sim::SignalBoard& board = *world.board;
   Json reply = {{"ok", true}, {"module", module}, {"sim_time_us", sim_time_us}, {"settable", bool(world.set_input)}};
   if (values_only != request.end() && values_only->get<bool>()) {
@@ -78,7 +82,9 @@ Result<Json> set_world(const Json& request, size_t module, const ConsoleWorld& w
                  ": its signals are not set from here (a node of a --node bus takes no --set or --scenario)"};
   }
   const auto signal = request.find("signal");
-  if (signal == request.end() || !signal->is_string()) return Error{"\"signal\": expected a signal name such as \"REF_L\""};
+  if (signal == request.end() || !signal->is_string()) {
+    return Error{"\"signal\": expected a signal name such as \"REF_L\""};
+  }
   const auto value = request.find("value");
   if (value == request.end() || !value->is_number()) return Error{"\"value\": expected a number"};
   const std::string name = signal->get<std::string>();
