@@ -188,6 +188,8 @@ def test_scope(motwin):
         browser.driver.get(server.url("/"))
         browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
         browser.show("scope")
+        # The rates are offered once the module list has arrived, which may follow "connected".
+        browser.wait("the scope's rates", lambda: browser.finds("#scope-rate option:checked") != [])
         check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "25",
                     "the scope's default rate on a TMCL module")
         check(browser.find("#scope-start").get_attribute("disabled") is not None, "Start before a curve is picked")

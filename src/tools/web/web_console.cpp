@@ -1065,8 +1065,10 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     timer_ = console_.loop().add_timer_at(due_us, [this] {
       timer_.reset();
       // Batches follow the wall clock; one that is still being read makes the next one wait
-      // (the page gets fewer, never stale-queued, updates).
-      if (!batch_in_flight_) start_batch();
+      // (the page gets fewer, never stale-queued, updates). One due before the simulation moved
+      // on (a late timer, then the next multiple of the period a moment later, or a loaded
+      // machine) is skipped: a page plots against simulated time, which must increase.
+      if (!batch_in_flight_ && console_.sim_time_us() != last_batch_sim_time_us_) start_batch();
       // The next batch at the next multiple of the period on the wall clock: sessions of the same
       // rate (or of rates that divide each other) start their batches in the same moment, so
       // that their reads of the same items are shared (TmclPort::shared_read).
@@ -1084,7 +1086,8 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
 
   void start_batch() {
     batch_in_flight_ = true;
-    auto batch = std::make_shared<Batch>(Batch{console_.sim_time_us(), Json::array(), subscribed_.size(), generation_});
+    last_batch_sim_time_us_ = console_.sim_time_us();
+    auto batch = std::make_shared<Batch>(Batch{last_batch_sim_time_us_, Json::array(), subscribed_.size(), generation_});
     for (size_t i = 0; i < subscribed_.size(); ++i) batch->values.push_back(subscribed_[i].echo);
     for (size_t i = 0; i < subscribed_.size(); ++i) {
       const Item& item = subscribed_[i];
@@ -1222,6 +1225,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
   size_t pending_ = 0;
   std::vector<Item> subscribed_;
   uint64_t period_us_ = 100'000;
+  uint64_t last_batch_sim_time_us_ = UINT64_MAX;  // none yet
   std::optional<host::EventLoop::TimerId> timer_;
   bool batch_in_flight_ = false;
   uint64_t generation_ = 0;
