@@ -33,21 +33,13 @@ Result<TmclReply> exchange(TmclClient& client, const tmcl::Instruction& request,
 Result<tmcl::Instruction> read_instruction(TmclClient& client, uint32_t address, uint8_t module_address,
                                            uint8_t* unexpected_status = nullptr) {
   const uint8_t ok = tmcl::to_byte(tmcl::Status::kOk);
-  const auto value_field = static_cast<int32_t>(address);
-  Result<TmclReply> opcode_and_value =
-      exchange(client, {cmd::kReadProgramMemory, 0, 0, value_field}, ok, module_address,
-               fmt::format("reading address {} (134 type 0)", address), unexpected_status);
+  Result<TmclReply> opcode_and_value = exchange(client, read_back_request(address, 0), ok, module_address,
+                                                fmt::format("reading address {} (134 type 0)", address), unexpected_status);
   if (!opcode_and_value) return Error{opcode_and_value.error()};
-  Result<TmclReply> type_and_motor = exchange(client, {cmd::kReadProgramMemory, 1, 0, value_field}, ok, module_address,
+  Result<TmclReply> type_and_motor = exchange(client, read_back_request(address, 1), ok, module_address,
                                               fmt::format("reading address {} (134 type 1)", address));
   if (!type_and_motor) return Error{type_and_motor.error()};
-  const auto fields = static_cast<uint32_t>(type_and_motor->value);
-  if (fields > 0xFFFF) {
-    return Error{
-        fmt::format("reading address {} (134 type 1): value 0x{:X} is not (type << 8) | motor", address, fields)};
-  }
-  return tmcl::Instruction{opcode_and_value->command, static_cast<uint8_t>(fields >> 8), static_cast<uint8_t>(fields),
-                           opcode_and_value->value};
+  return decode_read_back(address, opcode_and_value->command, opcode_and_value->value, type_and_motor->value);
 }
 
 Result<std::vector<tmcl::Instruction>> check_range(uint32_t start, uint32_t count) {
@@ -59,6 +51,38 @@ Result<std::vector<tmcl::Instruction>> check_range(uint32_t start, uint32_t coun
 }
 
 }  // namespace
+
+std::vector<TransferStep> download_steps(std::span<const tmcl::Instruction> instructions, uint32_t start) {
+  const uint8_t ok = tmcl::to_byte(tmcl::Status::kOk);
+  const uint8_t stored = tmcl::to_byte(tmcl::Status::kStoredInProgram);
+  std::vector<TransferStep> steps;
+  steps.reserve(instructions.size() + 3);
+  steps.push_back({{cmd::kEnterDownloadMode, 0, 0, static_cast<int32_t>(start)},
+                   ok,
+                   fmt::format("entering download mode at address {} (132)", start)});
+  for (size_t i = 0; i < instructions.size(); ++i) {
+    steps.push_back({instructions[i], stored,
+                     fmt::format("instruction {} at address {} ({})", i, start + i, format_instruction(instructions[i]))});
+  }
+  steps.push_back({{cmd::kNop, 0, 0, 0}, stored, "trailing NOP (command 0)"});
+  steps.push_back({leave_download_request(), ok, "leaving download mode (133)"});
+  return steps;
+}
+
+tmcl::Instruction leave_download_request() { return {cmd::kExitDownloadMode, 0, 0, 0}; }
+
+tmcl::Instruction read_back_request(uint32_t address, uint8_t type) {
+  return {cmd::kReadProgramMemory, type, 0, static_cast<int32_t>(address)};
+}
+
+Result<tmcl::Instruction> decode_read_back(uint32_t address, uint8_t opcode, int32_t value, int32_t type_and_motor) {
+  const auto fields = static_cast<uint32_t>(type_and_motor);
+  if (fields > 0xFFFF) {
+    return Error{
+        fmt::format("reading address {} (134 type 1): value 0x{:X} is not (type << 8) | motor", address, fields)};
+  }
+  return tmcl::Instruction{opcode, static_cast<uint8_t>(fields >> 8), static_cast<uint8_t>(fields), value};
+}
 
 Result<std::vector<tmcl::Instruction>> read_program(TmclClient& client, uint32_t start, uint32_t count,
                                                     uint8_t module_address) {
@@ -92,35 +116,22 @@ Result<std::vector<tmcl::Instruction>> read_stored_program(TmclClient& client, u
 
 Result<size_t> download_program(TmclClient& client, std::span<const tmcl::Instruction> instructions, uint32_t start,
                                 uint8_t module_address) {
-  const uint8_t ok = tmcl::to_byte(tmcl::Status::kOk);
-  const uint8_t stored = tmcl::to_byte(tmcl::Status::kStoredInProgram);
   if (start > static_cast<uint32_t>(std::numeric_limits<int32_t>::max())) {
     return Error{fmt::format("start address {} is out of range", start)};
   }
-  Result<TmclReply> entered =
-      exchange(client, {cmd::kEnterDownloadMode, 0, 0, static_cast<int32_t>(start)}, ok, module_address,
-               fmt::format("entering download mode at address {} (132)", start));
-  if (!entered) return Error{entered.error()};
-
-  const auto leave_after_failure = [&](const std::string& failure) -> Result<size_t> {
-    Result<TmclReply> left = client.request({cmd::kExitDownloadMode, 0, 0, 0}, module_address);
-    const bool left_ok = left && left->status == ok;
-    return Error{fmt::format("{}; {}", failure,
+  const std::vector<TransferStep> steps = download_steps(instructions, start);
+  for (size_t i = 0; i < steps.size(); ++i) {
+    Result<TmclReply> reply =
+        exchange(client, steps[i].request, steps[i].expected_status, module_address, steps[i].what);
+    if (reply) continue;
+    // 132 refused, or 133 itself: nothing to leave.
+    if (i == 0 || i + 1 == steps.size()) return Error{reply.error()};
+    Result<TmclReply> left = client.request(leave_download_request(), module_address);
+    const bool left_ok = left && left->status == tmcl::to_byte(tmcl::Status::kOk);
+    return Error{fmt::format("{}; {}", reply.error(),
                              left_ok ? "download mode left (133): program memory may hold part of the new program"
                                      : "the module may still be in download mode (133 failed)")};
-  };
-
-  for (size_t i = 0; i < instructions.size(); ++i) {
-    Result<TmclReply> reply =
-        exchange(client, instructions[i], stored, module_address,
-                 fmt::format("instruction {} at address {} ({})", i, start + i, format_instruction(instructions[i])));
-    if (!reply) return leave_after_failure(reply.error());
   }
-  Result<TmclReply> nop = exchange(client, {cmd::kNop, 0, 0, 0}, stored, module_address, "trailing NOP (command 0)");
-  if (!nop) return leave_after_failure(nop.error());
-  Result<TmclReply> left =
-      exchange(client, {cmd::kExitDownloadMode, 0, 0, 0}, ok, module_address, "leaving download mode (133)");
-  if (!left) return Error{left.error()};
   return instructions.size();
 }
 

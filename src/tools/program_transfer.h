@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/tmcl/instruction.h"
@@ -20,6 +21,27 @@
 #include "types/result.h"
 
 namespace motwin::tools {
+
+// The requests of a transfer, for hosts that do not block on a TmclClient (the web console,
+// src/tools/web/web_program.cpp): the same requests and checks as the functions below.
+
+// One request of a download and the status its reply must carry; `what` names it in errors.
+struct TransferStep {
+  tmcl::Instruction request;
+  uint8_t expected_status = 100;
+  std::string what;
+};
+
+// 132 with `start`, each instruction (101), the trailing NOP (101), 133 (100).
+std::vector<TransferStep> download_steps(std::span<const tmcl::Instruction> instructions, uint32_t start);
+// Leaves download mode after a refused step (its reply must carry status 100).
+tmcl::Instruction leave_download_request();
+
+// The two 134 requests that read the instruction at `address`: type 0, then type 1.
+tmcl::Instruction read_back_request(uint32_t address, uint8_t type);
+// The instruction from the replies to both (status 100 each): type 0 gives the opcode (reply
+// command byte) and the value, type 1 the value (type << 8) | motor.
+Result<tmcl::Instruction> decode_read_back(uint32_t address, uint8_t opcode, int32_t value, int32_t type_and_motor);
 
 // Reads `count` instructions from address `start` on (2 requests per instruction).
 Result<std::vector<tmcl::Instruction>> read_program(TmclClient& client, uint32_t start, uint32_t count,

@@ -42,13 +42,8 @@ std::string with_label(const tmcl::Instruction& instruction, const std::string& 
 
 }  // namespace
 
-std::string disassemble(std::span<const tmcl::Instruction> instructions, const DisassemblyOptions& options) {
-  const bool final_stop_omitted =
-      options.omit_final_stop && !instructions.empty() && instructions.back().command == tmcl::command::kStop &&
-      instructions.back().type == 0 && instructions.back().motor_bank == 0 && instructions.back().value == 0;
-  const size_t written = instructions.size() - (final_stop_omitted ? 1 : 0);
-
-  // Targets inside the program (the omitted STOP included) get labels.
+std::vector<DisassembledLine> disassemble_lines(std::span<const tmcl::Instruction> instructions) {
+  // Targets inside the program get labels.
   std::set<int64_t> targets;
   for (const tmcl::Instruction& instruction : instructions) {
     if (has_address_operand(instruction.command) && instruction.value >= 0 &&
@@ -56,21 +51,40 @@ std::string disassemble(std::span<const tmcl::Instruction> instructions, const D
       targets.insert(instruction.value);
     }
   }
+  std::vector<DisassembledLine> lines;
+  lines.reserve(instructions.size());
+  for (size_t address = 0; address < instructions.size(); ++address) {
+    const tmcl::Instruction& instruction = instructions[address];
+    DisassembledLine line;
+    line.address = static_cast<uint32_t>(address);
+    if (targets.contains(static_cast<int64_t>(address))) line.label = label_name(static_cast<int64_t>(address));
+    line.text = format_instruction(instruction);
+    if (has_address_operand(instruction.command) && targets.contains(instruction.value) &&
+        has_mnemonic_form(instruction)) {
+      line.text = with_label(instruction, line.text);
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+std::string disassemble(std::span<const tmcl::Instruction> instructions, const DisassemblyOptions& options) {
+  const bool final_stop_omitted =
+      options.omit_final_stop && !instructions.empty() && instructions.back().command == tmcl::command::kStop &&
+      instructions.back().type == 0 && instructions.back().motor_bank == 0 && instructions.back().value == 0;
+  const std::vector<DisassembledLine> lines = disassemble_lines(instructions);
+  const size_t written = lines.size() - (final_stop_omitted ? 1 : 0);
 
   std::string out = fmt::format("// {} instruction{}, disassembled by motwin\n", instructions.size(),
                                 instructions.size() == 1 ? "" : "s");
   for (size_t address = 0; address < written; ++address) {
-    const tmcl::Instruction& instruction = instructions[address];
-    if (targets.contains(static_cast<int64_t>(address))) out += label_name(static_cast<int64_t>(address)) + ":\n";
-    std::string text = format_instruction(instruction);
-    if (has_address_operand(instruction.command) && targets.contains(instruction.value) &&
-        has_mnemonic_form(instruction)) {
-      text = with_label(instruction, text);
-    }
-    out += options.address_comments ? fmt::format("    {:<32} // {}\n", text, address) : fmt::format("    {}\n", text);
+    const DisassembledLine& line = lines[address];
+    if (!line.label.empty()) out += line.label + ":\n";
+    out += options.address_comments ? fmt::format("    {:<32} // {}\n", line.text, address)
+                                    : fmt::format("    {}\n", line.text);
   }
   if (final_stop_omitted) {
-    if (targets.contains(static_cast<int64_t>(written))) out += label_name(static_cast<int64_t>(written)) + ":\n";
+    if (!lines.back().label.empty()) out += lines.back().label + ":\n";
     out += fmt::format("// STOP at address {}: appended by the assembler\n", written);
   }
   return out;

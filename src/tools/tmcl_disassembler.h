@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "core/tmcl/instruction.h"
 #include "types/result.h"
@@ -19,6 +20,16 @@ struct DisassemblyOptions {
   // "// 12" after each instruction: its address.
   bool address_comments = true;
 };
+
+// One instruction of a disassembly, for a view with one line per address (the web console's
+// Program view): the same text and labels as disassemble() writes.
+struct DisassembledLine {
+  uint32_t address = 0;
+  std::string label;  // "L12" when a jump, call or vector of the program targets this address
+  std::string text;   // the instruction; an address operand inside the program as its label
+};
+// Every instruction, a final STOP included.
+std::vector<DisassembledLine> disassemble_lines(std::span<const tmcl::Instruction> instructions);
 
 std::string disassemble(std::span<const tmcl::Instruction> instructions, const DisassemblyOptions& options = {});
 // The bytes of a .bin file (tmcl_binary.h); fails as decode_program_binary does.
