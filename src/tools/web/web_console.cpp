@@ -16,6 +16,7 @@
 #include "tools/canopen_object_text.h"
 #include "tools/tmcl_mnemonics.h"
 #include "tools/web/web_datalogger.h"
+#include "tools/web/web_program.h"
 
 namespace motwin::tools::web {
 
@@ -25,19 +26,10 @@ namespace {
 
 // --- TMCL through the module's host service --------------------------------------------------
 
-struct TmclAnswer {
-  bool replied = false;  // false: the module sends no reply to this command (137, another address)
-  uint8_t status = 0;
-  uint8_t command = 0;
-  int32_t value = 0;
-  std::optional<std::string> version;  // command 136 type 0
-};
-
 // The console's own connection to a TMCL module: requests go in as 9-byte frames, in order, as
 // many as the service takes; replies come back in the same order.
-class TmclPort final : public host::ReplyChannel {
+class TmclPort final : public host::ReplyChannel, public TmclRequests {
  public:
-  using Done = std::function<void(const TmclAnswer&)>;
   using EventListener = std::function<void(const TmclAnswer&)>;
 
   TmclPort(host::TmclHostService& service, uint8_t module_address, EventListener on_event)
@@ -51,7 +43,12 @@ class TmclPort final : public host::ReplyChannel {
   TmclPort(const TmclPort&) = delete;
   TmclPort& operator=(const TmclPort&) = delete;
 
-  void request(const tmcl::Instruction& instruction, Done done) {
+  void request(const tmcl::Instruction& instruction, Done done) override {
+    (held_ ? held_back_ : waiting_).push_back(Pending{instruction, std::move(done), false, {}});
+    feed();
+  }
+  bool hold() override { return !std::exchange(held_, true); }
+  void held_request(const tmcl::Instruction& instruction, Done done) override {
     waiting_.push_back(Pending{instruction, std::move(done), false, {}});
     feed();
   }
@@ -59,7 +56,7 @@ class TmclPort final : public host::ReplyChannel {
   // A read of a subscribed value: a read of the same parameter that is waiting and not yet served
   // answers `done` too (its answer comes from after both asked, as fresh as a read of its own),
   // so pages that show the same rows cost the module one read per row and period.
-  void shared_read(const tmcl::Instruction& instruction, Done done) {
+  void shared_read(const tmcl::Instruction& instruction, Done done) override {
     const auto same = [&instruction](const Pending& pending) {
       return pending.shared && pending.instruction.command == instruction.command &&
              pending.instruction.type == instruction.type && pending.instruction.motor_bank == instruction.motor_bank;
@@ -76,7 +73,16 @@ class TmclPort final : public host::ReplyChannel {
         return;
       }
     }
-    waiting_.push_back(Pending{instruction, std::move(done), true, {}});
+    // Held (a download): after it, or the module would store the read as an instruction.
+    (held_ ? held_back_ : waiting_).push_back(Pending{instruction, std::move(done), true, {}});
+    feed();
+  }
+  void release() override {
+    held_ = false;
+    while (!held_back_.empty()) {
+      waiting_.push_back(std::move(held_back_.front()));
+      held_back_.pop_front();
+    }
     feed();
   }
 
@@ -156,6 +162,8 @@ class TmclPort final : public host::ReplyChannel {
   EventListener on_event_;
   tmcl::ChannelId channel_ = 0;
   std::deque<Pending> waiting_;
+  bool held_ = false;
+  std::deque<Pending> held_back_;  // requests made while held
   std::deque<Pending> in_service_;
   std::vector<uint8_t> received_;
   size_t replied_not_served_ = 0;
@@ -632,9 +640,12 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       error = datalogger_op(request, id);
     } else if (is_world_op(name)) {
       error = world_request(name, request, id);
+    } else if (is_program_op(name)) {
+      error = program_op(name, request, id);
     } else {
       error = "unknown op \"" + name + "\" (list, get, set, store, restore, tmcl, sdo_read, sdo_write, nmt, "
-              "subscribe, unsubscribe, monitor, datalogger, nmt_state, world, world_set)";
+              "subscribe, unsubscribe, monitor, datalogger, nmt_state, world, world_set, " +
+              std::string(kProgramOpNames) + ")";
     }
     if (!error.empty()) send(Json{{"id", id}, {"ok", false}, {"error", error}});
   }
@@ -975,6 +986,19 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     sdo->nmt(kCommands.at(command->get<std::string>()), node);
     send(Json{{"id", id}, {"ok", true}, {"node", node}});
     return {};
+  }
+
+  // The Program view's ops (web_program.h) on a TMCL module.
+  std::string program_op(const std::string& name, const Json& request, const Json& id) {
+    std::string error;
+    size_t index = 0;
+    const ConsoleTarget* target = console_.target_of(request, index, error);
+    if (target == nullptr) return error;
+    if (console_.port(index) == nullptr) return "module " + target->name + " takes no TMCL from the console";
+    auto reply = replying<Json>([](Session& session, const Json& message) { session.send(message); });
+    error = start_program_op(name, request, id, *console_.port(index), std::move(reply));
+    if (!error.empty()) --pending_;  // no reply will come through `reply`
+    return error;
   }
 
   // {"op":"tmcl","module":N,"text":"MVP ABS, 0, 1000"}: one instruction as `motwin tmcl` takes it.
