@@ -176,6 +176,7 @@
     if (window.MotwinDatalogger) window.MotwinDatalogger.moduleChosen();
     if (state.view === "canopen") startCanopenView();
     if (state.view === "world") window.MotwinWorld.start(state.module, socketUrl());
+    announceView();
   }
 
   // One table row per parameter or object entry, with the fields a request needs.
@@ -994,6 +995,12 @@
     if (name === "console") $("console-input").focus();
     if (name === "canopen") startCanopenView();
     if (name === "world") window.MotwinWorld.start(state.module, socketUrl());
+    announceView();
+  }
+
+  // Views in files of their own (program.js) follow the chosen view and module by this event.
+  function announceView() {
+    document.dispatchEvent(new CustomEvent("motwin-view", { detail: { view: state.view, module: currentModule() } }));
   }
 
   function start() {

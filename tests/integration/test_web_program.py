@@ -1,0 +1,254 @@
+#!/usr/bin/python3
+"""The web console's program ops and Program view (docs/web-console.md): over a real WebSocket
+(python3-websocket) on a TMCM-1636 and a TMCM-142, and in headless Chromium (Selenium): a program
+assembled and downloaded from the page, read back and disassembled, stepped with the program
+counter and accumulator the page shows checked against command 135 over TMCL/TCP, run (a user
+variable counts, read over TCP), stopped, reset; assembler errors with line numbers; the view in
+a 400 pixel wide window; no SEVERE entry in the browser's log. Screenshots in
+<build>/test-artefacts/web-program/. The browser test skips (status 77) only when Chromium cannot
+start."""
+
+import os
+import sys
+import time
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import motwin_harness as mh  # noqa: E402
+from motwin_harness import TcpClient, TempDir, check, check_equal, run_tests  # noqa: E402
+import browser_harness as bh  # noqa: E402
+import web_harness as wh  # noqa: E402
+
+try:  # without Selenium, bh.HeadlessChromium skips the test before any of these is used
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+except ImportError:  # pragma: no cover - reported as a skip
+    pass
+
+WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
+APPLICATION_STATUS = 135
+GLOBAL_BANK_USER = 2
+# Counts in the accumulator and copies it to user variable 0 (GGP 0, 2).
+COUNTER = """// counter: user variable 0 counts up
+Loop:  CALC ADD, 1
+       AGP 0, 2
+       JA Loop
+"""
+# Stepping from a reset: (program counter, accumulator) after each 130.
+STEPS = [(1, 1), (2, 1), (0, 1), (1, 2)]
+
+
+class Web142Server(wh.WebServer):
+    BANNER = mh.Tmcm142Server.BANNER
+
+    def __init__(self, motwin, state_dir, **options):
+        super().__init__(motwin, state_dir, module="tmcm-142", **options)
+
+
+def require_websocket():
+    if wh.websocket is None:
+        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
+
+
+def tcp_status(tmcl):
+    """(mode, program counter, accumulator) by command 135 over TMCL/TCP."""
+    status = mh.expect_reply(tmcl.request(APPLICATION_STATUS, 1), APPLICATION_STATUS, what="135 type 1").value
+    accumulator = mh.expect_reply(tmcl.request(APPLICATION_STATUS, 2), APPLICATION_STATUS, what="135 type 2").value
+    return (status >> 24) & 0xFF, status & 0xFFFF, accumulator
+
+
+def wait_for(description, condition):
+    deadline = time.monotonic() + WAIT_S
+    while True:
+        value = condition()
+        if value:
+            return value
+        check(time.monotonic() < deadline, f"waited {WAIT_S} s for {description}")
+        time.sleep(0.01)
+
+
+def check_program_ops(server):
+    with TcpClient(server.tcp_port) as tmcl, server.console() as console:
+        reply = console.ask("program_download", module=0, source=COUNTER, file_name="counter.tmc")
+        check_equal((reply["ok"], reply["count"], reply["verified"]), (True, 4, True), f"download: {reply}")
+        check_equal(reply["labels"], [{"name": "Loop", "address": 0}], "labels of the download")
+        # What a TMCL host reads back with 134 is what was downloaded.
+        for address, (command, value) in enumerate([(19, 1), (35, 0), (22, 0), (28, 0)]):
+            stored = tmcl.request(134, 0, 0, address)
+            check_equal((stored.status, stored.command, stored.value), (100, command, value), f"134 at {address}")
+
+        read = console.ask("program_read", module=0)
+        check_equal(read["end"], "nop", "program_read ends at the download's NOP")
+        check_equal([(line["address"], line.get("label"), line["text"]) for line in read["instructions"]],
+                    [(0, "L0", "CALC ADD, 1"), (1, None, "AGP 0, 2"), (2, None, "JA L0"), (3, None, "STOP")],
+                    "the program read back, one line per address")
+
+        check_equal(console.ask("program_control", module=0, action="reset")["status"], 100, "reset (131)")
+        for step, expected in enumerate(STEPS):
+            check_equal(console.ask("program_control", module=0, action="step")["ok"], True, f"step {step}")
+            # The instruction runs at the next control tick: wait for it, then compare with TCP.
+            wait_for(f"step {step}", lambda: tcp_status(tmcl)[1:] == expected)
+            status = console.ask("app_status", module=0)
+            check_equal((status["mode_name"], status["program_counter"], status["accumulator"]),
+                        ("step",) + expected, f"app_status after step {step}")
+            check_equal((status["mode"], status["program_counter"], status["accumulator"]), tcp_status(tmcl),
+                        f"app_status = 135 over TCP after step {step}")
+
+        check_equal(console.ask("program_control", module=0, action="continue")["status"], 100, "continue")
+        before = tmcl.ggp(0, GLOBAL_BANK_USER)
+        wait_for("user variable 0 to count", lambda: tmcl.ggp(0, GLOBAL_BANK_USER) > before + 100)
+        check_equal(console.ask("program_control", module=0, action="stop")["status"], 100, "stop (128)")
+        status = console.ask("app_status", module=0)
+        check_equal((status["mode_name"], status["stop_reason"]), ("stop", 2), "status after stop")
+        check_equal(tcp_status(tmcl)[0], 0, "mode over TCP after the console's stop")
+
+        failed = console.ask("program_download", module=0, source="  MVP ABS, 0, 1000\n  FLY 1\n", file_name="bad.tmc")
+        check_equal((failed["ok"], failed["errors"][0]["line"]), (False, 2), f"assembly error: {failed}")
+        check_equal(tmcl.request(134, 0, 0, 0).command, 19, "program memory after a source that does not assemble")
+
+
+def test_program_ops_over_websocket(motwin):
+    require_websocket()
+    for server_class in (wh.WebServer, Web142Server):
+        with TempDir() as state, server_class(motwin, state).start() as server:
+            check_program_ops(server)
+            server.stop()
+
+
+class Browser(bh.HeadlessChromium):
+    def wait(self, description, condition):
+        try:
+            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
+        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
+            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
+
+    def find(self, css):
+        return self.driver.find_element(By.CSS_SELECTOR, css)
+
+    def finds(self, css):
+        return self.driver.find_elements(By.CSS_SELECTOR, css)
+
+    def text(self, element_id):
+        return self.driver.find_element(By.ID, element_id).text
+
+    def status_shown(self):
+        """(mode, program counter, accumulator) as the view shows them, or None before a status."""
+        shown = [self.text("program-mode"), self.text("program-pc"), self.text("program-accumulator")]
+        if "–" in shown:
+            return None
+        return shown[0], int(shown[1]), int(shown[2])
+
+    def replies_seen(self):
+        return self.js("return window.motwinProgram.statusReplies")
+
+    def screenshot(self, motwin, name):
+        path = os.path.join(bh.artefact_dir(motwin, "web-program"), name + ".png")
+        check(self.driver.save_screenshot(path), f"screenshot {path}")
+
+
+MODE_NAMES = {0: "stop", 1: "run", 2: "step", 3: "reset"}
+
+
+def test_program_view(motwin):
+    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+            TcpClient(server.tcp_port) as tmcl:
+        browser.driver.get(server.url("/"))
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.find('#tabs [data-view="program"]').click()
+        browser.wait("the program view", lambda: browser.find("#view-program").is_displayed())
+        # Factory memory: STOP everywhere, read to its end.
+        browser.wait("the stored program", lambda: len(browser.finds("#program-lines tbody tr")) == 2048)
+        browser.wait("a live status", lambda: browser.status_shown() is not None)
+
+        # A source with errors: nothing downloaded, the errors with their line numbers.
+        source = browser.find("#program-source")
+        source.send_keys("  MVP ABS, 0, 1000\n  FLY 1\n  JA Nowhere\n")
+        browser.find("#program-download").click()
+        browser.wait("the assembler's errors", lambda: len(browser.finds("#program-errors li")) == 2)
+        errors = [item.text for item in browser.finds("#program-errors li")]
+        check(errors[0].startswith("program.tmc line 2") and "FLY" in errors[0], f"first error: {errors}")
+        check(errors[1].startswith("program.tmc line 3"), f"second error: {errors}")
+        browser.screenshot(motwin, "program-errors")
+        check_equal(tmcl.request(134, 0, 0, 0).command, 28, "program memory after a source with errors (STOP)")
+        browser.finds("#program-errors li")[0].click()  # selects line 2 in the source
+        check_equal(browser.js("const a = document.getElementById('program-source');"
+                               "return a.value.substring(a.selectionStart, a.selectionEnd)"), "  FLY 1",
+                    "the error's line selected in the source")
+
+        # The counter, downloaded from the page and verified, read back one line per address.
+        browser.js("document.getElementById('program-source').value = arguments[0]", COUNTER)
+        browser.find("#program-download").click()
+        browser.wait("the download", lambda: "verified" in browser.text("program-note"))
+        check_equal(browser.finds("#program-errors li"), [], "no errors after a good download")
+        browser.wait("the program read back", lambda: len(browser.finds("#program-lines tbody tr")) == 4)
+        lines = [[cell.text for cell in row.find_elements(By.TAG_NAME, "td")]
+                 for row in browser.finds("#program-lines tbody tr")]
+        check_equal([line[1:] for line in lines], [["L0", "CALC ADD, 1"], ["", "AGP 0, 2"], ["", "JA L0"], ["", "STOP"]],
+                    "the listing")
+        check_equal(tmcl.request(134, 0, 0, 2).command, 22, "JA stored at address 2, read over TCP")
+
+        # Reset, then step: the view's PC and accumulator equal 135 over TCP; the PC line is marked.
+        browser.find("#program-reset").click()
+        browser.wait("reset", lambda: browser.status_shown() == ("reset", 0, 0))
+        for step, expected in enumerate(STEPS):
+            browser.find("#program-step").click()
+            browser.wait(f"step {step} shown", lambda: browser.status_shown() == ("step",) + expected)
+            mode, pc, accumulator = tcp_status(tmcl)
+            check_equal((MODE_NAMES[mode], pc, accumulator), browser.status_shown(), f"135 over TCP after step {step}")
+            marked = browser.finds("#program-lines tr.pc")
+            check_equal([row.get_attribute("data-address") for row in marked], [str(expected[0])],
+                        f"the line at the program counter after step {step}")
+        browser.screenshot(motwin, "program-step")
+
+        # Run: user variable 0 counts (read over TCP) and the view's accumulator follows.
+        before = tmcl.ggp(0, GLOBAL_BANK_USER)
+        browser.find("#program-continue").click()
+        wait_for("user variable 0 to count", lambda: tmcl.ggp(0, GLOBAL_BANK_USER) > before + 1000)
+        browser.wait("the view's accumulator to follow",
+                     lambda: browser.status_shown()[0] == "run" and browser.status_shown()[2] > before + 1000)
+        # Live: several status replies a second (wall time) while the view is open.
+        seen = browser.replies_seen()
+        start = time.monotonic()
+        browser.wait("more status replies", lambda: browser.replies_seen() >= seen + 10)
+        rate = 10 / (time.monotonic() - start)
+        print(f"program view: {rate:.1f} status updates a second", flush=True)
+        browser.screenshot(motwin, "program-run")
+        browser.find("#program-stop").click()
+        browser.wait("stop shown", lambda: browser.status_shown()[0] == "stop")
+        check_equal(tcp_status(tmcl)[0], 0, "mode over TCP after the page's Stop")
+        check("stopped by the host" in browser.text("program-stop-reason"), "the stop reason shown")
+        stopped_at = tmcl.ggp(0, GLOBAL_BANK_USER)
+        tmcl.wait_sim_ms(50)
+        check_equal(tmcl.ggp(0, GLOBAL_BANK_USER), stopped_at, "user variable 0 50 ms after Stop")
+        browser.find("#program-reset").click()
+        browser.wait("reset shown", lambda: browser.status_shown() == ("reset", 0, 0))
+        check_equal(tcp_status(tmcl), (3, 0, 0), "135 over TCP after the page's Reset")
+
+        # Run from a line picked in the listing: address 3 is the STOP, which stops the program there.
+        browser.finds("#program-lines tbody tr")[3].click()
+        check_equal(browser.find("#program-address").get_attribute("value"), "3", "the picked address")
+        browser.find("#program-run").click()
+        browser.wait("the STOP at 3", lambda: browser.text("program-stop-reason") == "STOP instruction at 3")
+        check_equal(mh.expect_reply(tmcl.request(APPLICATION_STATUS, 4), APPLICATION_STATUS).value, (1 << 16) | 3,
+                    "135 type 4 over TCP: STOP instruction at address 3")
+        check_equal(tmcl.ggp(0, GLOBAL_BANK_USER), stopped_at, "user variable 0 after running only the STOP")
+        browser.screenshot(motwin, "program")
+
+        # A narrow window: nothing wider than the window.
+        browser.driver.set_window_size(400, 800)
+        browser.wait("the narrow layout", lambda: browser.js(
+            "return document.documentElement.scrollWidth <= window.innerWidth + 1"))
+        browser.screenshot(motwin, "program-narrow")
+        # Leaving the view closes its session: no more status replies.
+        browser.find('#tabs [data-view="parameters"]').click()
+        seen = browser.replies_seen()
+        tmcl.wait_sim_ms(300)
+        check(browser.replies_seen() <= seen + 1, "status replies after leaving the view")
+        severe = browser.severe_log_entries()
+        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+        server.stop()
+
+
+if __name__ == "__main__":
+    run_tests([test_program_ops_over_websocket, test_program_view])
