@@ -513,7 +513,8 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
       targets.push_back(descriptor.canopen != nullptr
                             ? tools::web::canopen_target(descriptor, member.name, firmware,
                                                          configured_node_id(spec.node_id))
-                            : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware, nullptr));
+                            : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware, nullptr,
+                                                      bus != nullptr ? member.module->tmcl_can_node() : nullptr));
       targets.back().world.board = &member.module->signals();  // read only: a node takes no scenario
     }
   }

@@ -338,8 +338,8 @@ def test_scope_module_switch(motwin):
         browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
         browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
         browser.show("scope")
-        # The TMCM-1636 speaks TMCL on the bus only: not reachable from the console, nothing to plot.
-        check_equal(browser.finds("#scope-choices input"), [], "no curves of a module the console cannot reach")
+        # The TMCM-1636 speaks TMCL on the bus only: the console reaches it by TMCL over CAN.
+        browser.wait("the TMCM-1636's parameters as curves", lambda: browser.finds('#scope-choices input[data-key="a52"]') != [])
         Select(browser.find("#module-picker")).select_by_value("1")
         browser.wait("the TMCM-3216's objects", lambda: browser.finds('#scope-choices input[data-key="o6060.0"]') != [])
         check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "10",
@@ -352,7 +352,8 @@ def test_scope_module_switch(motwin):
             "return window.motwinConsole.scopeRunning;"))
         check_equal(browser.driver.execute_script("return window.motwinConsole.scope;"), None,
                     "the other module's plot is gone")
-        check_equal(browser.finds("#scope-choices input"), [], "the TMCM-3216's objects are gone")
+        check_equal(browser.finds('#scope-choices input[data-key="o6060.0"]'), [], "the TMCM-3216's objects are gone")
+        check(browser.finds('#scope-choices input[data-key="a52"]') != [], "the TMCM-1636's parameters again")
         check_equal(Select(browser.find("#scope-rate")).first_selected_option.get_attribute("value"), "25",
                     "a TMCL module's default rate")
         browser.check_log_clean()

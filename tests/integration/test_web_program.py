@@ -9,6 +9,7 @@ a 400 pixel wide window; no SEVERE entry in the browser's log. Screenshots in
 start."""
 
 import os
+import struct
 import sys
 import time
 
@@ -18,6 +19,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import motwin_harness as mh  # noqa: E402
 from motwin_harness import TcpClient, TempDir, check, check_equal, run_tests  # noqa: E402
 import browser_harness as bh  # noqa: E402
+import can_bus_harness as cbh  # noqa: E402
 import web_harness as wh  # noqa: E402
 
 try:  # without Selenium, bh.HeadlessChromium skips the test before any of these is used
@@ -114,6 +116,105 @@ def test_program_ops_over_websocket(motwin):
         with TempDir() as state, server_class(motwin, state).start() as server:
             check_program_ops(server)
             server.stop()
+
+
+def test_tmcl_over_can_node(motwin):
+    """A TMCM-1636 that is only a node of the bus (`--node tmcm-1636` beside a TMCM-3216) is reached
+    by TMCL over CAN: parameters, a direct-mode instruction, the program ops, an ID change; checked
+    by a TMCL-over-CAN host on socketcand (python3-can)."""
+    require_websocket()
+    try:
+        import can  # noqa: F401 - Debian's python3-can
+    except ImportError:
+        raise mh.Skipped("python3-can is not installed (scripts/install-deps.sh installs it)")
+    args = ["--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0",
+            "--web", "127.0.0.1:0"]
+    with TempDir() as state, cbh.BusServer(motwin, state, args).start() as server:
+        bus = cbh.open_bus(server.port())
+        host = cbh.TmclCan(bus)
+        try:
+            with wh.ConsoleClient(server.port("web")) as console:
+                modules = console.ask("list")["modules"]
+                check_equal([(m["name"], m["protocol"]) for m in modules],
+                            [("tmcm-1636-1", "tmcl"), ("tmcm-3216-2", "canopen")], "the listed modules")
+                check_equal(modules[0]["tmcl_can"], {"receive_id": 1, "send_id": 2}, "TMCL over CAN IDs")
+                check(any(p["number"] == 11 for p in modules[0]["sections"][0]["parameters"]), "AP 11 listed")
+
+                # A parameter set by the console, read by the CAN host, and the other way round.
+                check_equal(console.ask("set", module=0, kind="global", number=0, bank=2, value=4321)["status"], 100,
+                            "SGP 0, 2 over CAN")
+                sync_can_host(console, bus)
+                check_equal(host.ok(10, 0, 2), 4321, "GGP 0, 2 by the CAN host")
+                host.ok(5, 11, 0, 1111)  # SAP 11 (max current), 0, 1111
+                check_equal(console.ask("get", module=0, number=11)["value"], 1111, "GAP 11 by the console")
+                refused = console.ask("set", module=0, number=11, value=60001)
+                check_equal((refused["ok"], refused["status"]), (False, 4), "the module's own range check over CAN")
+                reply = console.ask("tmcl", module=0, text="136 0")
+                check(reply["ok"] and reply["version"].startswith("1636V1"), f"136 0 over CAN: {reply}")
+                update = console.ask("subscribe", items=[{"module": 0, "kind": "global", "number": 0, "bank": 2}],
+                                     rate_hz=20)
+                check_equal(update["ok"], True, "subscribe over CAN")
+                check_equal(console.next_update()["values"][0]["value"], 4321, "a live value over CAN")
+                console.ask("unsubscribe")
+
+                # The program ops over CAN, checked with 134 and 135 by the CAN host.
+                reply = console.ask("program_download", module=0, source=COUNTER)
+                check_equal((reply["ok"], reply["verified"]), (True, True), f"download over CAN: {reply}")
+                sync_can_host(console, bus)
+                check_equal(host.request(134, 0, 0, 2)[2], 22, "134 at 2 by the CAN host: JA")
+                read = console.ask("program_read", module=0)
+                check_equal([line["text"] for line in read["instructions"]], ["CALC ADD, 1", "AGP 0, 2", "JA L0", "STOP"],
+                            "program_read over CAN")
+                console.ask("program_control", module=0, action="reset")
+                for step, expected in enumerate(STEPS):
+                    check_equal(console.ask("program_control", module=0, action="step")["ok"], True, f"step {step}")
+                    wait_for(f"step {step}", lambda: (console.ask("app_status", module=0)["program_counter"],
+                                                      console.ask("app_status", module=0)["accumulator"]) == expected)
+                    sync_can_host(console, bus)
+                    pc = host.ok(135, 1) & 0xFFFF
+                    check_equal((pc, host.ok(135, 2)), expected, f"135 by the CAN host after step {step}")
+
+                # New IDs (SGP 71, 70) take effect with the next frame: the console follows them.
+                check_equal(console.ask("set", module=0, kind="global", number=71, bank=0, value=5)["status"], 100,
+                            "SGP 71 = 5")
+                check_equal(console.ask("set", module=0, kind="global", number=70, bank=0, value=6)["status"], 100,
+                            "SGP 70 = 6")
+                check_equal(console.ask("get", module=0, kind="global", number=0, bank=2)["value"], 1,
+                            "GGP over the new IDs")
+                check_equal(console.ask("list")["modules"][0]["tmcl_can"], {"receive_id": 5, "send_id": 6},
+                            "the IDs listed")
+                sync_can_host(console, bus, send_id=6)
+                check_equal(cbh.TmclCan(bus, receive_id=5, send_id=6).ok(10, 0, 2), 1, "the CAN host on the new IDs")
+
+                # The bus monitor shows the console's TMCL frames and the module's replies.
+                check_equal(console.ask("monitor", enable=True)["ok"], True, "monitor")
+                console.ask("get", module=0, kind="global", number=0, bank=2)
+                seen_ids = set()
+
+                def console_frames_seen():
+                    console.ask("list")  # reads the pushes that came meanwhile
+                    for push in console.pushes:
+                        if push["push"] == "frames":
+                            seen_ids.update(frame["id"] for frame in push["frames"])
+                    console.pushes.clear()
+                    return {5, 6} <= seen_ids
+                wait_for("the console's TMCL frames in the monitor", console_frames_seen)
+        finally:
+            bus.shutdown()
+        server.stop()
+
+
+SYNC_MARKS = iter(range(1000, 1000000))
+
+
+def sync_can_host(console, bus, send_id=2):
+    """The CAN host hears every reply the module sends the console too (TMCL over CAN has no
+    request tag): it drops them, up to the reply to an SGP of user variable 50 with a value of
+    its own that the console sends last."""
+    mark = next(SYNC_MARKS)
+    check_equal(console.ask("tmcl", module=0, text=f"SGP 50, 2, {mark}")["status"], 100, "SGP 50, 2 over CAN")
+    cbh.receive(bus, lambda m: m.arbitration_id == send_id and len(m.data) >= 7 and m.data[2] == 9 and
+                struct.unpack_from(">i", bytes(m.data), 3)[0] == mark, mh.FRAME_TIMEOUT, f"the reply to SGP 50, 2, {mark}")
 
 
 class Browser(bh.HeadlessChromium):
@@ -251,4 +352,4 @@ def test_program_view(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_program_ops_over_websocket, test_program_view])
+    run_tests([test_program_ops_over_websocket, test_tmcl_over_can_node, test_program_view])

@@ -13,8 +13,10 @@
 #include "core/canopen/sdo_abort.h"
 #include "core/tmcl/serial_link.h"
 #include "core/tmcl/status.h"
+#include "host/tmcl_can_node.h"
 #include "tools/canopen_object_text.h"
 #include "tools/tmcl_mnemonics.h"
+#include "tools/web/tmcl_can_port.h"
 #include "tools/web/web_datalogger.h"
 #include "tools/web/web_program.h"
 
@@ -418,7 +420,8 @@ struct RequestError {
 // --- Targets -----------------------------------------------------------------------------------
 
 ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
-                          std::string_view firmware_generation, host::TmclHostService* service) {
+                          std::string_view firmware_generation, host::TmclHostService* service,
+                          host::TmclCanNode* can_node) {
   ConsoleTarget target;
   target.name = std::move(name);
   target.module = std::string(descriptor.name);
@@ -427,6 +430,7 @@ ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string 
   Result<host::ModuleParameterListing> listing = host::firmware_listing(descriptor, firmware_generation);
   target.listing = listing ? std::move(*listing) : descriptor.listing();
   target.tmcl = service;
+  target.tmcl_can = can_node;
   return target;
 }
 
@@ -461,6 +465,12 @@ class WebConsole::Impl {
       if (target.tmcl != nullptr) {
         ports_[i] = std::make_unique<TmclPort>(*target.tmcl, target.module_address,
                                                [this, i](const TmclAnswer& answer) { broadcast_event(i, answer); });
+      } else if (target.tmcl_can != nullptr && bus != nullptr) {
+        auto port = std::make_unique<TmclCanPort>(
+            *bus, loop_, [node = target.tmcl_can] { return node->settings(); },
+            [this, i](const TmclAnswer& answer) { broadcast_event(i, answer); });
+        port->monitor = [this](const can::CanFrame& frame, uint64_t timestamp_us) { broadcast_frame(frame, timestamp_us); };
+        ports_[i] = std::move(port);
       }
     }
     if (bus != nullptr) {
@@ -499,7 +509,7 @@ class WebConsole::Impl {
     return &targets_[index];
   }
 
-  TmclPort* port(size_t index) {
+  TmclRequests* port(size_t index) {
     const auto found = ports_.find(index);
     return found == ports_.end() ? nullptr : found->second.get();
   }
@@ -528,7 +538,7 @@ class WebConsole::Impl {
   host::EventLoop& loop_;
   std::function<uint64_t()> sim_time_us_;
   std::vector<ConsoleTarget> targets_;
-  std::map<size_t, std::unique_ptr<TmclPort>> ports_;
+  std::map<size_t, std::unique_ptr<TmclRequests>> ports_;
   std::unique_ptr<SdoMaster> sdo_;
   std::set<Session*> sessions_;
 };
@@ -694,8 +704,12 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
                      {"type", target.module},
                      {"product", target.product_name},
                      {"firmware", target.firmware},
-                     {"protocol", target.tmcl != nullptr ? "tmcl" : target.canopen_node_id ? "canopen" : "none"},
+                     {"protocol", console_.port(i) != nullptr ? "tmcl" : target.canopen_node_id ? "canopen" : "none"},
                      {"sections", listing_json(target)}};
+      if (target.tmcl == nullptr && target.tmcl_can != nullptr && console_.port(i) != nullptr) {
+        const tmcl::CanSettings ids = target.tmcl_can->settings();
+        module["tmcl_can"] = {{"receive_id", ids.receive_id}, {"send_id", ids.send_id}};
+      }
       if (target.canopen_node_id) {
         module["node_id"] = *target.canopen_node_id;
         if (console_.sdo() != nullptr) {
@@ -734,7 +748,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     if (target == nullptr) return std::nullopt;
     item.echo = Json::object();
     item.echo["module"] = item.module;
-    if (target->tmcl != nullptr) {
+    if (console_.port(item.module) != nullptr) {
       const auto kind = request.find("kind");
       const std::string kind_text = kind != request.end() && kind->is_string() ? kind->get<std::string>() : "axis";
       if (kind_text != "axis" && kind_text != "global") {
@@ -782,6 +796,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
   }
 
   static Json tmcl_reply_json(const Json& id, const TmclAnswer& answer) {
+    if (!answer.error.empty()) return Json{{"id", id}, {"ok", false}, {"error", answer.error}};
     if (!answer.replied) return Json{{"id", id}, {"ok", true}, {"replied", false}};
     Json reply = {{"id", id},
                   {"ok", tmcl::is_success(answer.status)},
@@ -1007,7 +1022,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     size_t index = 0;
     const ConsoleTarget* target = console_.target_of(request, index, error);
     if (target == nullptr) return error;
-    if (target->tmcl == nullptr) return "module " + target->name + " takes no TMCL from the console";
+    if (console_.port(index) == nullptr) return "module " + target->name + " takes no TMCL from the console";
     const auto text = request.find("text");
     if (text == request.end() || !text->is_string()) return "\"text\": expected an instruction such as \"GAP 1, 0\"";
     const Result<tmcl::Instruction> instruction = parse_instruction(text->get<std::string>());
@@ -1034,7 +1049,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     if (target->tmcl == nullptr) return "module " + target->name + " takes no TMCL from the console: no datalogger";
     std::variant<DataloggerPlan, std::string> plan = parse_datalogger_request(request);
     if (const std::string* refused = std::get_if<std::string>(&plan)) return *refused;
-    TmclPort* port = console_.port(index);
+    TmclRequests* port = console_.port(index);
     DataloggerLink link;
     link.request = [port](const tmcl::Instruction& instruction, std::function<void(const DataloggerAnswer&)> done) {
       port->request(instruction, [done = std::move(done)](const TmclAnswer& answer) {
@@ -1128,6 +1143,10 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
         instruction.motor_bank = item.motor_bank;
         console_.port(item.module)->shared_read(instruction, [finish_one](const TmclAnswer& answer) {
           finish_one([&answer](Json& value) {
+            if (!answer.error.empty()) {
+              value["error"] = answer.error;
+              return;
+            }
             value["status"] = answer.status;
             if (tmcl::is_success(answer.status)) value["value"] = answer.value;
           });

@@ -24,6 +24,10 @@
 #include "host/web/web_server.h"
 #include "tools/web/world_ops.h"
 
+namespace motwin::host {
+class TmclCanNode;
+}  // namespace motwin::host
+
 namespace motwin::tools::web {
 
 // One module or node the console reaches.
@@ -34,6 +38,7 @@ struct ConsoleTarget {
   std::string firmware;          // "1636V109"
   host::ModuleParameterListing listing;
   host::TmclHostService* tmcl = nullptr;  // a TMCL module served directly
+  host::TmclCanNode* tmcl_can = nullptr;  // or a TMCL module on the bus: reached by TMCL over CAN
   uint8_t module_address = 1;             // of its TMCL requests
   std::optional<uint8_t> canopen_node_id;  // a CANopen node on the bus
   ConsoleWorld world;                      // its simulated world (ops "world", "world_set")
@@ -73,10 +78,11 @@ class WebConsole {
 };
 
 // The console's targets for `motwin serve`: the module itself (TMCL through `service`, or a
-// CANopen node), or each node of a group. A TMCL module that is only a node of a bus is listed
-// without a way to reach it (the console speaks no TMCL over CAN yet).
+// CANopen node), or each node of a group. A TMCL module that is only a node of a bus is reached
+// by TMCL over CAN through `can_node` (tmcl_can_port.h); without a bus, not at all.
 ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
-                          std::string_view firmware_generation, host::TmclHostService* service);
+                          std::string_view firmware_generation, host::TmclHostService* service,
+                          host::TmclCanNode* can_node = nullptr);
 ConsoleTarget canopen_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
                              uint8_t node_id);
 

@@ -1,6 +1,7 @@
-// How the web console's ops reach a TMCL module: one instruction at a time through the module's
-// own TMCL service, as a host's 9-byte request (the console's TmclPort, web_console.cpp). The
-// program ops (web_program.h) see only this interface.
+// How the web console's ops reach a TMCL module: its requests as a host's, either 9-byte frames
+// through the module's own TMCL service (the console's TmclPort, web_console.cpp) or TMCL over
+// CAN frames on serve's virtual bus (TmclCanPort, tmcl_can_port.h). The ops see only this
+// interface.
 #pragma once
 
 #include <cstdint>
@@ -19,6 +20,7 @@ struct TmclAnswer {
   uint8_t command = 0;
   int32_t value = 0;
   std::optional<std::string> version;  // command 136 type 0
+  std::string error;                   // set: no answer came (TMCL over CAN: a timeout)
 };
 
 class TmclRequests {
@@ -40,8 +42,7 @@ class TmclRequests {
   virtual void held_request(const tmcl::Instruction& instruction, Done done) = 0;
   virtual void release() = 0;
 
- protected:
-  ~TmclRequests() = default;
+  virtual ~TmclRequests() = default;
 };
 
 }  // namespace motwin::tools::web
