@@ -351,5 +351,42 @@ def test_program_view(motwin):
         server.stop()
 
 
+def test_program_view_over_can(motwin):
+    """The Program view of a TMCM-1636 that is only a node of the bus (TMCL over CAN): download and
+    step from the page, the status shown equal to app_status asked by a script's session (over the
+    same console port: a second TMCL-over-CAN host would confuse the module's replies)."""
+    args = ["--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0",
+            "--web", "127.0.0.1:0"]
+    with Browser() as browser, TempDir() as state, cbh.BusServer(motwin, state, args).start() as server, \
+            wh.ConsoleClient(server.port("web")) as console:
+        browser.driver.get(f"http://127.0.0.1:{server.port('web')}/")
+        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
+        browser.find('#tabs [data-view="program"]').click()
+        browser.wait("the program view", lambda: browser.find("#program-body").is_displayed())
+        browser.wait("a live status", lambda: browser.status_shown() is not None)
+        browser.js("document.getElementById('program-source').value = arguments[0]", COUNTER)
+        browser.find("#program-download").click()
+        browser.wait("the download", lambda: "verified" in browser.text("program-note"))
+        browser.wait("the program read back", lambda: len(browser.finds("#program-lines tbody tr")) == 4)
+        browser.find("#program-reset").click()
+        browser.wait("reset", lambda: browser.status_shown() == ("reset", 0, 0))
+        for step, expected in enumerate(STEPS[:2]):
+            browser.find("#program-step").click()
+            browser.wait(f"step {step} shown", lambda: browser.status_shown() == ("step",) + expected)
+            status = console.ask("app_status", module=0)
+            check_equal(("step", status["program_counter"], status["accumulator"]), browser.status_shown(),
+                        f"app_status of a script after step {step}")
+        browser.screenshot(motwin, "program-can-node")
+        # The CANopen node beside it has no program: the view says so.
+        browser.js("const p = document.getElementById('module-picker'); p.value = '1';"
+                   "p.dispatchEvent(new Event('change'));")
+        browser.wait("the line for a module without TMCL", lambda: browser.find("#program-none").is_displayed())
+        check(not browser.find("#program-body").is_displayed(), "no program body for a CANopen node")
+        severe = browser.severe_log_entries()
+        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+        server.stop()
+
+
 if __name__ == "__main__":
-    run_tests([test_program_ops_over_websocket, test_tmcl_over_can_node, test_program_view])
+    run_tests([test_program_ops_over_websocket, test_tmcl_over_can_node, test_program_view, test_program_view_over_can])
