@@ -1,7 +1,8 @@
 // The web console reaching a TMCL module by TMCL over CAN (tools/web/tmcl_can_port.h) without
 // sockets: a TMCM-1636 as a node of a virtual bus, the console a client of that bus. Parameters
 // through the module's own checks, the version string, the program ops, new IDs (SGP 70/71)
-// followed at once, replies of another CAN host ignored, and a module that does not answer.
+// followed at once, replies of another CAN host ignored, the bus monitor showing the console's
+// frames once, and a module that does not answer.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -84,6 +85,10 @@ class CanRig {
     ADD_FAILURE() << "no reply to " << request.dump();
     return Json{};
   }
+  void run_wall_us(uint64_t wall_us) {
+    const uint64_t until_us = host::monotonic_now_us() + wall_us;
+    while (host::monotonic_now_us() < until_us) runtime_->step(1000);
+  }
   host::CanBus& bus() { return *bus_; }
   host::VirtualModule& module() { return *module_; }
   FakeConnection& connection() { return connection_; }
@@ -145,6 +150,27 @@ TEST(WebTmclOverCan, another_hosts_replies_are_not_taken_for_the_consoles) {
   other.send(tmcl::encode_can_request(1, tmcl::Instruction{tmcl::command::kGap, 11, 0, 0}));
   EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 11}})["command"], 6);
   for (const Json& message : rig.connection().messages) EXPECT_FALSE(message.contains("push")) << message.dump();
+}
+
+TEST(WebTmclOverCan, the_bus_monitor_shows_the_consoles_request_and_the_reply_once_each) {
+  CanRig rig;
+  ASSERT_EQ(rig.ask({{"op", "monitor"}})["ok"], true);
+  rig.ask({{"op", "get"}, {"number", 11}});
+  std::vector<Json> frames;
+  const uint64_t give_up_us = host::monotonic_now_us() + 5'000'000;
+  while (frames.size() < 2 && host::monotonic_now_us() < give_up_us) {
+    rig.run_wall_us(10'000);  // "frames" pushes come every 100 ms
+    for (const Json& message : rig.connection().messages) {
+      if (message.value("push", "") == "frames") {
+        for (const Json& frame : message["frames"]) frames.push_back(frame);
+      }
+    }
+    rig.connection().messages.clear();
+  }
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0]["id"], 1);
+  EXPECT_EQ(frames[0]["data"], "060B0000000000");
+  EXPECT_EQ(frames[1]["id"], 2);
 }
 
 TEST(WebTmclOverCan, a_module_that_does_not_answer_ends_the_request_with_an_error) {

@@ -60,7 +60,6 @@ void TmclCanPort::send_next() {
         finish(std::move(none));
       });
     }
-    if (monitor) monitor(frame, bus_.now_us());
     bus_.send(id_, frame);
     if (!answered && in_flight_) finish(TmclAnswer{});
   }

@@ -41,9 +41,6 @@ class TmclCanPort final : public host::CanBusEndpoint, public TmclRequests {
   // host::CanBusEndpoint.
   void on_frame(const can::CanFrame& frame, uint64_t timestamp_us) override;
 
-  // Frames the console sends (the bus does not echo them back), for the bus monitor.
-  std::function<void(const can::CanFrame&, uint64_t timestamp_us)> monitor;
-
  private:
   struct Pending {
     tmcl::Instruction instruction;

@@ -466,11 +466,10 @@ class WebConsole::Impl {
         ports_[i] = std::make_unique<TmclPort>(*target.tmcl, target.module_address,
                                                [this, i](const TmclAnswer& answer) { broadcast_event(i, answer); });
       } else if (target.tmcl_can != nullptr && bus != nullptr) {
-        auto port = std::make_unique<TmclCanPort>(
+        // Its frames reach the bus monitor through the SDO client, which hears them like any other.
+        ports_[i] = std::make_unique<TmclCanPort>(
             *bus, loop_, [node = target.tmcl_can] { return node->settings(); },
             [this, i](const TmclAnswer& answer) { broadcast_event(i, answer); });
-        port->monitor = [this](const can::CanFrame& frame, uint64_t timestamp_us) { broadcast_frame(frame, timestamp_us); };
-        ports_[i] = std::move(port);
       }
     }
     if (bus != nullptr) {
