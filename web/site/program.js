@@ -300,6 +300,12 @@
       view.selected = null;
       view.status = null;
       renderLines();
+      $("program-listing-note").textContent = "";
+      $("program-errors").replaceChildren();
+      note("");
+      for (const id of ["program-mode", "program-pc", "program-accumulator", "program-x", "program-wait", "program-stop-reason"]) {
+        $(id).textContent = "–";
+      }
     }
     view.module = module;
     if (shown && (!view.shown || changed || !view.socket)) open();
