@@ -1045,7 +1045,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     size_t index = 0;
     const ConsoleTarget* target = console_.target_of(request, index, error);
     if (target == nullptr) return error;
-    if (target->tmcl == nullptr) return "module " + target->name + " takes no TMCL from the console: no datalogger";
+    if (console_.port(index) == nullptr) return "module " + target->name + " takes no TMCL from the console: no datalogger";
     std::variant<DataloggerPlan, std::string> plan = parse_datalogger_request(request);
     if (const std::string* refused = std::get_if<std::string>(&plan)) return *refused;
     TmclRequests* port = console_.port(index);
