@@ -50,11 +50,7 @@
 
   // --- Connection --------------------------------------------------------------------------------
 
-  function socketUrl() {
-    const token = new URLSearchParams(location.search).get("token");
-    const scheme = location.protocol === "https:" ? "wss:" : "ws:";
-    return scheme + "//" + location.host + "/ws" + (token ? "?token=" + encodeURIComponent(token) : "");
-  }
+  const socketUrl = window.motwinSession.socketUrl;
 
   function setConnection(text, name) {
     $("connection").textContent = text;
@@ -77,35 +73,9 @@
     });
   }
 
-  // A WebSocket session of a view's own (the Scope's, the CANopen view's): `handlers.open(socket)`
-  // once open, `handlers.message(message)` with each message parsed, `handlers.close()` when it
-  // ends, each only while `isCurrent(socket)` (the view has not moved on to another session).
-  function openSession(isCurrent, handlers) {
-    const socket = new WebSocket(socketUrl(), "motwin");
-    socket.addEventListener("open", () => {
-      if (isCurrent(socket) && handlers.open) handlers.open(socket);
-    });
-    socket.addEventListener("message", (event) => {
-      if (!isCurrent(socket)) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      handlers.message(message);
-    });
-    socket.addEventListener("close", () => {
-      if (isCurrent(socket) && handlers.close) handlers.close();
-    });
-    return socket;
-  }
-
-  function closeSession(socket) {
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
-  }
+  // The Scope's and the CANopen view's sessions (session.js).
+  const openSession = window.motwinSession.open;
+  const closeSession = window.motwinSession.close;
 
   function request(message, callback) {
     const id = state.nextId++;
@@ -175,7 +145,7 @@
     resetScopeChoices();
     if (window.MotwinDatalogger) window.MotwinDatalogger.moduleChosen();
     if (state.view === "canopen") startCanopenView();
-    if (state.view === "world") window.MotwinWorld.start(state.module, socketUrl());
+    if (state.view === "world") window.MotwinWorld.start(state.module);
     announceView();
   }
 
@@ -994,7 +964,7 @@
     for (const view of document.querySelectorAll(".view")) view.hidden = view.id !== "view-" + name;
     if (name === "console") $("console-input").focus();
     if (name === "canopen") startCanopenView();
-    if (name === "world") window.MotwinWorld.start(state.module, socketUrl());
+    if (name === "world") window.MotwinWorld.start(state.module);
     announceView();
   }
 

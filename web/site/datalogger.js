@@ -51,44 +51,30 @@
     return global.motwinConsole || {};
   }
 
-  function socketUrl() {
-    const token = new URLSearchParams(location.search).get("token");
-    const scheme = location.protocol === "https:" ? "wss:" : "ws:";
-    return scheme + "//" + location.host + "/ws" + (token ? "?token=" + encodeURIComponent(token) : "");
-  }
-
   // --- The mode's session -------------------------------------------------------------------------
 
   // The mode's requests go one at a time, each after the previous one's reply: a Stop's INIT
   // then never lands between the instructions of a start still being sent.
   function openSession() {
     if (state.socket) return;
-    const socket = new WebSocket(socketUrl(), "motwin");
-    state.socket = socket;
-    socket.addEventListener("open", () => { if (state.socket === socket) pump(); });
-    socket.addEventListener("message", (event) => {
-      if (state.socket !== socket) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      const callback = state.waiting.get(message.id);
-      if (callback) {
-        state.waiting.delete(message.id);
+    state.socket = global.motwinSession.open((socket) => state.socket === socket, {
+      open: () => pump(),
+      message: (message) => {
+        const callback = state.waiting.get(message.id);
+        if (callback) {
+          state.waiting.delete(message.id);
+          state.inFlight = false;
+          callback(message);
+          pump();
+        }
+      },
+      close: () => {
+        state.socket = null;
+        state.waiting.clear();
+        state.queue = [];
         state.inFlight = false;
-        callback(message);
-        pump();
-      }
-    });
-    socket.addEventListener("close", () => {
-      if (state.socket !== socket) return;
-      state.socket = null;
-      state.waiting.clear();
-      state.queue = [];
-      state.inFlight = false;
-      if (state.running) stopCapture("connection closed", false);
+        if (state.running) stopCapture("connection closed", false);
+      },
     });
   }
 
@@ -98,9 +84,7 @@
     state.waiting.clear();
     state.queue = [];
     state.inFlight = false;
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
+    global.motwinSession.close(socket);
   }
 
   function ask(message, callback) {

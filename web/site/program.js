@@ -30,12 +30,6 @@
     get lines() { return view.lines; },
   };
 
-  function socketUrl() {
-    const token = new URLSearchParams(location.search).get("token");
-    const scheme = location.protocol === "https:" ? "wss:" : "ws:";
-    return scheme + "//" + location.host + "/ws" + (token ? "?token=" + encodeURIComponent(token) : "");
-  }
-
   function reachable(module) {
     return module && module.protocol === "tmcl";
   }
@@ -71,31 +65,22 @@
     $("program-none").hidden = reachable(module);
     $("program-body").hidden = !reachable(module);
     if (!reachable(module)) return;
-    const socket = new WebSocket(socketUrl(), "motwin");
-    view.socket = socket;
-    socket.addEventListener("open", () => {
-      if (view.socket !== socket) return;
-      note("");
-      readProgram();
-      pollStatus();
-    });
-    socket.addEventListener("message", (event) => {
-      if (view.socket !== socket) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      const callback = view.waiting.get(message.id);
-      if (!callback) return;
-      view.waiting.delete(message.id);
-      callback(message);
-    });
-    socket.addEventListener("close", () => {
-      if (view.socket !== socket) return;
-      close();
-      note("connection closed", true);
+    view.socket = window.motwinSession.open((socket) => view.socket === socket, {
+      open: () => {
+        note("");
+        readProgram();
+        pollStatus();
+      },
+      message: (message) => {
+        const callback = view.waiting.get(message.id);
+        if (!callback) return;
+        view.waiting.delete(message.id);
+        callback(message);
+      },
+      close: () => {
+        close();
+        note("connection closed", true);
+      },
     });
   }
 
@@ -105,9 +90,7 @@
     view.waiting.clear();
     const socket = view.socket;
     view.socket = null;
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
+    window.motwinSession.close(socket);
   }
 
   // --- Status --------------------------------------------------------------------------------------

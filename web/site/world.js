@@ -67,7 +67,7 @@
     return true;
   }
 
-  function start(module, url) {
+  function start(module) {
     stop();
     view.module = module;
     view.values = {};
@@ -77,31 +77,19 @@
     $("world-controls").replaceChildren();
     $("world-none").hidden = true;
     note("connecting…");
-    const socket = new WebSocket(url, "motwin");
-    view.socket = socket;
-    socket.addEventListener("open", () => {
-      if (view.socket !== socket) return;
-      send({ op: "world", module: module }, onTable);
-    });
-    socket.addEventListener("message", (event) => {
-      if (view.socket !== socket) return;
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch (error) {
-        return;
-      }
-      const callback = view.waiting.get(message.id);
-      if (callback) {
-        view.waiting.delete(message.id);
-        callback(message);
-      }
-    });
-    socket.addEventListener("close", () => {
-      if (view.socket === socket) {
+    view.socket = window.motwinSession.open((socket) => view.socket === socket, {
+      open: () => send({ op: "world", module: module }, onTable),
+      message: (message) => {
+        const callback = view.waiting.get(message.id);
+        if (callback) {
+          view.waiting.delete(message.id);
+          callback(message);
+        }
+      },
+      close: () => {
         stop();
         note("connection closed");
-      }
+      },
     });
   }
 
@@ -112,9 +100,7 @@
     view.waiting.clear();
     const socket = view.socket;
     view.socket = null;
-    // Closing a socket still connecting makes the browser log an error: close it once open.
-    if (socket && socket.readyState === WebSocket.CONNECTING) socket.addEventListener("open", () => socket.close());
-    else if (socket) socket.close();
+    window.motwinSession.close(socket);
   }
 
   function onTable(reply) {

@@ -1,4 +1,5 @@
 #include "tools/web/web_console.h"
+#include "tools/web/web_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -397,18 +398,6 @@ std::string_view nmt_state_name(uint8_t state) {
     case 127: return "pre-operational";
     default: return "unknown";
   }
-}
-
-// An integer field of a request, or why not.
-std::optional<int64_t> integer_field(const Json& request, const char* name) {
-  const auto found = request.find(name);
-  if (found == request.end() || !found->is_number_integer()) return std::nullopt;
-  if (found->is_number_unsigned()) {
-    const uint64_t value = found->get<uint64_t>();
-    if (value > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) return std::nullopt;
-    return static_cast<int64_t>(value);
-  }
-  return found->get<int64_t>();
 }
 
 struct RequestError {

@@ -1,4 +1,5 @@
 #include "tools/web/web_datalogger.h"
+#include "tools/web/web_json.h"
 
 #include <algorithm>
 #include <limits>
@@ -19,17 +20,6 @@ namespace {
 
 // The most samples per channel a request may ask for; the module clamps the capture to its buffer.
 constexpr int64_t kMaxSamplesPerChannel = 1 << 20;
-
-std::optional<int64_t> integer_of(const Json& object, const char* name) {
-  const auto found = object.find(name);
-  if (found == object.end() || !found->is_number_integer()) return std::nullopt;
-  if (found->is_number_unsigned()) {
-    const uint64_t value = found->get<uint64_t>();
-    if (value > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) return std::nullopt;
-    return static_cast<int64_t>(value);
-  }
-  return found->get<int64_t>();
-}
 
 const char* state_name(int32_t state) {
   switch (state) {
@@ -303,10 +293,10 @@ std::variant<DataloggerPlan, std::string> parse_datalogger_request(const Json& r
     const std::string kind_text = kind != given.end() && kind->is_string() ? kind->get<std::string>() : "axis";
     if (kind_text != "axis" && kind_text != "global") return std::string("\"kind\": expected \"axis\" or \"global\"");
     channel.axis = kind_text == "axis";
-    const std::optional<int64_t> number = integer_of(given, "number");
+    const std::optional<int64_t> number = integer_field(given, "number");
     if (!number || *number < 0 || *number > 255) return std::string("\"number\": expected a parameter number 0..255");
     const char* motor_bank_name = channel.axis ? "axis" : "bank";
-    const std::optional<int64_t> motor_bank = integer_of(given, motor_bank_name);
+    const std::optional<int64_t> motor_bank = integer_field(given, motor_bank_name);
     if (given.contains(motor_bank_name) && (!motor_bank || *motor_bank < 0 || *motor_bank > 255)) {
       return std::string("\"") + motor_bank_name + "\": expected 0..255";
     }
@@ -314,13 +304,13 @@ std::variant<DataloggerPlan, std::string> parse_datalogger_request(const Json& r
     channel.motor_bank = static_cast<uint8_t>(motor_bank.value_or(0));
     plan.channels.push_back(channel);
   }
-  const std::optional<int64_t> samples = integer_of(request, "samples");
+  const std::optional<int64_t> samples = integer_field(request, "samples");
   if (!samples || *samples < 1 || *samples > kMaxSamplesPerChannel) {
     return std::string("\"samples\": expected the samples per channel, 1..") + std::to_string(kMaxSamplesPerChannel);
   }
   plan.samples_per_channel = static_cast<uint32_t>(*samples);
   if (request.contains("prescaler")) {
-    const std::optional<int64_t> prescaler = integer_of(request, "prescaler");
+    const std::optional<int64_t> prescaler = integer_field(request, "prescaler");
     if (!prescaler || *prescaler < 0 || *prescaler > std::numeric_limits<int32_t>::max()) {
       return std::string("\"prescaler\": expected the divider minus one, 0 or more");
     }
@@ -329,12 +319,12 @@ std::variant<DataloggerPlan, std::string> parse_datalogger_request(const Json& r
   const auto trigger = request.find("trigger");
   if (trigger == request.end() || trigger->is_null()) return plan;
   if (!trigger->is_object()) return std::string("\"trigger\": expected an object or null");
-  const std::optional<int64_t> channel = integer_of(*trigger, "channel");
+  const std::optional<int64_t> channel = integer_field(*trigger, "channel");
   if (!channel || *channel < 0 || static_cast<size_t>(*channel) >= plan.channels.size()) {
     return std::string("\"trigger\".\"channel\": expected the index of one of \"channels\"");
   }
   plan.trigger_channel = static_cast<size_t>(*channel);
-  const std::optional<int64_t> level = integer_of(*trigger, "level");
+  const std::optional<int64_t> level = integer_field(*trigger, "level");
   if (!level || *level < std::numeric_limits<int32_t>::min() || *level > std::numeric_limits<uint32_t>::max()) {
     return std::string("\"trigger\".\"level\": expected a 32-bit integer");
   }
@@ -356,7 +346,7 @@ std::variant<DataloggerPlan, std::string> parse_datalogger_request(const Json& r
   }
   plan.trigger_type = signed_compare ? type : static_cast<uint8_t>(type + 3);  // 4..6: unsigned
   if (trigger->contains("pretrigger")) {
-    const std::optional<int64_t> pretrigger = integer_of(*trigger, "pretrigger");
+    const std::optional<int64_t> pretrigger = integer_field(*trigger, "pretrigger");
     if (!pretrigger || *pretrigger < 0 || *pretrigger > *samples) {
       return std::string("\"trigger\".\"pretrigger\": expected samples per channel, 0..\"samples\"");
     }

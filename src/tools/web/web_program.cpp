@@ -1,4 +1,5 @@
 #include "tools/web/web_program.h"
+#include "tools/web/web_json.h"
 
 #include <algorithm>
 #include <array>
@@ -32,17 +33,6 @@ constexpr uint8_t kOk = tmcl::to_byte(tmcl::Status::kOk);
 // connection may have queued at the service (docs/host-runtime.md).
 constexpr uint32_t kReadBackChunk = 16;
 constexpr size_t kMaxMismatchesListed = 10;
-
-std::optional<int64_t> integer_field(const Json& request, const char* name) {
-  const auto found = request.find(name);
-  if (found == request.end() || !found->is_number_integer()) return std::nullopt;
-  if (found->is_number_unsigned()) {
-    const uint64_t value = found->get<uint64_t>();
-    if (value > static_cast<uint64_t>(std::numeric_limits<int64_t>::max())) return std::nullopt;
-    return static_cast<int64_t>(value);
-  }
-  return found->get<int64_t>();
-}
 
 // An optional integer field within [low, high]; `error` set when present but not.
 std::optional<int64_t> bounded_field(const Json& request, const char* name, int64_t low, int64_t high,
