@@ -491,6 +491,13 @@ def test_canopen_view(motwin):
         check_equal(len(monitor_rows()), paused_rows, "no rows added while paused")
         browser.find("#monitor-pause").click()
         browser.find("#monitor-hide-sdo").click()
+        # Without 1003 the history lists the node's EMCYs heard on the bus: an undervoltage of the
+        # enabled axis 0 (FF00, docs/tmcm-3216-drive.md) set in the simulated world.
+        check("none" in browser.find("#canopen-emcy").text, "no EMCY heard yet")
+        reply = console.ask("world_set", module=0, signal="VSUPPLY", value=7)
+        check(reply["ok"], f"world_set VSUPPLY 7: {reply}")
+        browser.wait("the undervoltage EMCY in the history", lambda: any(
+            "EMCY 0xFF00" in item.text for item in browser.finds("#canopen-emcy li.emcy-heard")))
         browser.driver.execute_script("document.getElementById('monitor').scrollIntoView(false);")
         browser.screenshot(motwin, "canopen-monitor")
         browser.driver.execute_script("window.scrollTo(0, 0);")

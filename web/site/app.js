@@ -627,6 +627,8 @@
     items: [],        // [{axis, what}] in the order subscribed
     pdoGeneration: 0, // a newer Read (or leaving the view) abandons an older one
     monitor: { paused: false, frames: 0, dropped: 0, shown: 0 },
+    emcyHeard: [],       // EMCYs of the chosen node heard on the bus (no 1003 to read)
+    emcyFrom1003: false,
     viewGeneration: 0,
   };
 
@@ -701,6 +703,8 @@
     renderAxes();
     canopen.monitor.frames = 0;
     canopen.monitor.dropped = 0;
+    canopen.emcyHeard = [];
+    canopen.emcyFrom1003 = false;
     showMonitorNote();
     let nextId = 2;
     canopen.socket = openSession((socket) => canopen.socket === socket, {
@@ -798,7 +802,13 @@
     const count = await ask({ op: "sdo_read", module: module.module, index: 0x1003, sub: 0 });
     if (generation !== canopen.viewGeneration) return;
     list.replaceChildren();
-    if (!count.ok) return line("EMCY history (1003): " + replyText(count), "info");
+    canopen.emcyFrom1003 = count.ok;
+    if (!count.ok) {
+      // No pre-defined error field (the TMCM-3216 has none): the EMCYs the node sent on the bus
+      // since the view opened, newest first, as the monitor heard them.
+      line("EMCY history (1003): " + replyText(count) + "; EMCYs heard on the bus since the view opened:", "info");
+      return showEmcyHeard();
+    }
     if (count.value === 0) return line("EMCY history (1003): empty", "info");
     for (let sub = 1; sub <= count.value; sub++) {
       const entry = await ask({ op: "sdo_read", module: module.module, index: 0x1003, sub: sub });
@@ -810,6 +820,39 @@
       const code = entry.value & 0xFFFF, extra = entry.value >>> 16;
       line("EMCY 0x" + hex4(code) + (extra ? ", additional 0x" + extra.toString(16).toUpperCase() : ""));
     }
+  }
+
+  function showEmcyHeard() {
+    const list = $("canopen-emcy");
+    while (list.children.length > 1) list.lastChild.remove();
+    if (canopen.emcyHeard.length === 0) {
+      const item = document.createElement("li");
+      item.textContent = "none";
+      list.appendChild(item);
+    }
+    for (const emcy of canopen.emcyHeard.slice().reverse()) {
+      const item = document.createElement("li");
+      item.className = "emcy-heard";
+      item.textContent = (emcy.t_us / 1e6).toFixed(4) + " s: EMCY 0x" + hex4(emcy.code) + ", register 0x" +
+        emcy.register.toString(16).toUpperCase().padStart(2, "0");
+      list.appendChild(item);
+    }
+  }
+
+  // An EMCY of the chosen node in the monitor's frames (COB-ID 0x80 + node; 0x80 is SYNC).
+  function noteEmcys(frames) {
+    const module = currentModule();
+    if (!module || module.node_id === undefined) return;
+    let heard = false;
+    for (const frame of frames) {
+      if (frame.extended || frame.rtr || frame.id !== 0x80 + module.node_id) continue;
+      const bytes = bytesOf(frame.data);
+      if (bytes.length < 3) continue;
+      canopen.emcyHeard.push({ t_us: frame.t_us, code: u16(bytes, 0), register: bytes[2] });
+      heard = true;
+    }
+    while (canopen.emcyHeard.length > EMCY_HEARD_KEPT) canopen.emcyHeard.shift();
+    if (heard && !canopen.emcyFrom1003 && $("canopen-emcy").children.length > 0) showEmcyHeard();
   }
 
   // The PDOs the dictionary has: communication 1400.. (RPDO) / 1800.. (TPDO), mapping + 0x200.
@@ -859,6 +902,7 @@
   // connection set of CiA-301 (COB-ID = function code + node ID).
 
   const MONITOR_ROWS = 500;
+  const EMCY_HEARD_KEPT = 50;
   const NMT_COMMANDS = { 1: "start", 2: "stop", 128: "enter pre-operational", 129: "reset node", 130: "reset communication" };
   const HEARTBEAT_STATES = { 0: "boot-up", 4: "stopped", 5: "operational", 127: "pre-operational" };
   const SDO_REQUESTS = { 0: "download segment", 1: "initiate download", 2: "initiate upload", 3: "upload segment", 4: "abort" };
@@ -904,6 +948,7 @@
   }
 
   function onFrames(message) {
+    noteEmcys(message.frames);
     const monitor = canopen.monitor;
     monitor.frames += message.frames.length;
     monitor.dropped = message.dropped;
