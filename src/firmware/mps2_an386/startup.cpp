@@ -24,6 +24,9 @@ void Uart0Tx_Handler();
   for (;;) asm volatile("bkpt 0");
 }
 
+// What the unused stack holds (docs/firmware.md, "Per-tick figures").
+constexpr uint32_t kStackPaint = 0x5AC3A55Cu;
+
 [[noreturn]] void Reset_Handler() {
   using namespace motwin::firmware::mps2_an386;
   // Full access to CP10 and CP11 before any floating-point instruction runs.
@@ -31,6 +34,12 @@ void Uart0Tx_Handler();
   asm volatile("dsb\n\tisb" ::: "memory");
   for (uint32_t *from = &_sidata, *to = &_sdata; to < &_edata;) *to++ = *from++;
   for (uint32_t* to = &_sbss; to < &_ebss;) *to++ = 0;
+  // The free stack painted with kStackPaint, up to a little below this function's own frame:
+  // the words still painted later show the stack's high-water mark (bench/firmware_figures.py
+  // reads them through qemu's monitor; docs/firmware.md, "Per-tick figures").
+  uint32_t* stack_pointer;
+  asm volatile("mov %0, sp" : "=r"(stack_pointer));
+  for (uint32_t* to = &_ebss; to < stack_pointer - 16;) *to++ = kStackPaint;
   for (auto* init = __preinit_array_start; init < __preinit_array_end; ++init) (*init)();
   for (auto* init = __init_array_start; init < __init_array_end; ++init) (*init)();
   firmware_main();

@@ -19,6 +19,13 @@ namespace motwin::firmware::mps2_an386 {
 // The serial port at the modules' default (GP 65 code 7).
 inline constexpr uint32_t kDefaultBaud = 115200;
 
+// One control tick, never inlined: its entry is one address, where bench/firmware_figures.py
+// starts each tick's instruction count (docs/firmware.md, "Per-tick figures").
+template <class Module>
+[[gnu::noinline]] void run_control_tick(Module& module) {
+  module.tick();
+}
+
 template <class Module>
 [[noreturn]] void run_tmcl_module(Module& module, Uart0Output& uart) {
   module.engine().power_up();
@@ -27,7 +34,7 @@ template <class Module>
   uint32_t ticks_run = 0;
   for (;;) {
     while (ticks_run != system_tick_count()) {
-      module.tick();
+      run_control_tick(module);
       ++ticks_run;
     }
     const uint64_t now_us = module.tick_count() * Module::kControlTickUs;
