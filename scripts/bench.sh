@@ -69,6 +69,22 @@ for bench in "${benches[@]}"; do
   fi
 done
 
+# The firmware images under qemu (docs/firmware.md, "Per-tick figures"): skipped, with the reason
+# in the report, without qemu-system-arm or the ARM toolchain.
+log "building the firmware images (build-cortex-m/) and measuring them under qemu"
+MOTWIN_JOBS=$jobs scripts/build-firmware.sh >"$logs/firmware-build.log" 2>&1 ||
+  { tail -40 "$logs/firmware-build.log" >&2; failed+=(firmware_images); }
+firmware_ticks=2000
+[ $quick = 1 ] && firmware_ticks=500
+status=0
+/usr/bin/python3 bench/firmware_figures.py --ticks $firmware_ticks --json-file "$logs/firmware_figures.json" \
+  >"$logs/firmware_figures.txt" 2>"$logs/firmware_figures.err" || status=$?
+if [ $status != 0 ] && [ $status != 77 ]; then
+  log "bench/firmware_figures.py failed (exit status $status); its output is in $logs/"
+  echo "(failed: see $logs/firmware_figures.err)" >>"$logs/firmware_figures.txt"
+  failed+=(firmware_figures)
+fi
+
 size -t "$minsize/libmotwin_core.a" >"$logs/core_size.txt"
 /usr/bin/python3 scripts/core_size.py "$minsize" --symbols 15 --image "$minsize/core_all_modules.map" \
   >"$logs/core_breakdown.txt" ||
@@ -232,6 +248,24 @@ if image:
                  f"{image_bytes} B text ({image_bytes / 1024:.1f} KiB)",
                  f"the archive's {text_bytes} B" if total else "", "what the modules reach; the goal is judged by the archive"))
 
+firmware_json = os.path.join(logs, "firmware_figures.json")
+if os.path.exists(firmware_json):
+    import json
+    with open(firmware_json) as f:
+        for image in json.load(f):
+            rest, moving = image["rest"], image["moving"]
+            rows.append((f"{image['module']} firmware image (Cortex-M4F, qemu): instructions per 50 us control tick "
+                         "while moving (mean / max)", f"{moving['mean']:,.0f} / {moving['max']:,}",
+                         f"at rest {rest['mean']:,.0f} / {rest['max']:,}",
+                         f"at least {100 * moving['mean'] / 3600:.0f} % of a 72 MHz part, "
+                         f"{100 * moving['mean'] / 8400:.0f} % of a 168 MHz part"))
+            rows.append((f"{image['module']} firmware image: flash / RAM / stack high-water mark",
+                         f"{image['text'] + image['data']:,} B / {image['data'] + image['bss']:,} B / "
+                         f"{image['stack_used']:,} B", "", "text + data / data + bss / deepest stack seen"))
+else:
+    rows.append(("firmware images under qemu", "n/a", "", text("firmware_figures").strip().replace("|", "/")
+                 or "bench/firmware_figures.py failed or missing"))
+
 footprint = text("bench_module_footprint")
 
 now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
@@ -247,6 +281,8 @@ report = [f"# Motwin performance report", "",
 report += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in rows]
 report += ["", "## Memory per module instance and whole-module simulation speed", "",
            footprint.strip() or "(bench_module_footprint missing)", ""]
+report += ["## The firmware images on a Cortex-M4F (qemu)", "",
+           text("firmware_figures").strip() or "(bench/firmware_figures.py missing)", ""]
 report += ["## What the core's text is", "", text("core_breakdown").strip() or "(scripts/core_size.py missing)", ""]
 report += ["## Each benchmark's own summary", ""]
 for name in benches:
