@@ -87,6 +87,9 @@ class Board:
             except OSError:
                 self.serial.close()
                 if self.process.poll() is not None or time.monotonic() > deadline:
+                    self.process.kill()
+                    self.process.wait()
+                    self.log.close()
                     raise RuntimeError(f"qemu did not start: {self.qemu_log()}")
                 time.sleep(0.02)
 
@@ -202,7 +205,8 @@ def measure(name, image, plugin, ticks, skip):
             if status != STATUS_OK:
                 raise RuntimeError(f"STAP {spec['stored']}: status {status}")
             stack_bottom, stack_top = found["_ebss"], found["_estack"]
-            board.monitor(f"pmemsave {stack_bottom:#x} {stack_top - stack_bottom} stack.bin")  # relative: qemu parses '/'
+            # A relative file name (in qemu's working directory): the monitor parses '/' as a division.
+            board.monitor(f"pmemsave {stack_bottom:#x} {stack_top - stack_bottom} stack.bin")
             with open(os.path.join(directory, "stack.bin"), "rb") as f:
                 stack = f.read()
         finally:
@@ -229,7 +233,8 @@ def markdown(results, ticks):
              "|---|---|---|---|---|---|" + "---|" * len(CLOCKS_MHZ)]
     for r in results:
         rest, moving = r["rest"], r["moving"]
-        loads = " | ".join(f"{load(moving['mean'], mhz):.1f} % / {load(moving['max'], mhz):.1f} %" for mhz in CLOCKS_MHZ)
+        loads = " | ".join(f"{load(moving['mean'], mhz):.1f} % / {load(moving['max'], mhz):.1f} %"
+                           for mhz in CLOCKS_MHZ)
         lines.append(f"| {r['module']} | {r['text']:,} + {r['data']:,} B | {r['data']:,} + {r['bss']:,} B | "
                      f"{r['stack_used']:,} B (of {r['stack_used'] + r['stack_free']:,}) | "
                      f"{rest['min']:,} / {rest['mean']:,.0f} / {rest['max']:,} | "
