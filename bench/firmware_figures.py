@@ -7,6 +7,7 @@ would put on a 72 MHz and a 168 MHz Cortex-M4.
     bench/firmware_figures.py                    # build-cortex-m/, both images, a markdown table
     bench/firmware_figures.py --ticks 500 tmcm1636
     bench/firmware_figures.py --json            # the figures as JSON (tests/integration/test_firmware_figures.py)
+    bench/firmware_figures.py --profile 15      # also where the ticks' instructions go: the 15 costliest functions
 
 qemu runs each image with `-icount shift=0,sleep=off` (one instruction per nanosecond of the
 board's time, so the counts do not depend on the host's load) and the plugin
@@ -22,6 +23,7 @@ Exit status 77 (and a message) when qemu-system-arm, the ARM toolchain, a C comp
 images are missing: nothing was measured.
 """
 import argparse
+import bisect
 import json
 import os
 import re
@@ -65,13 +67,14 @@ def frame(command, type_, bank, value):
 class Board:
     """qemu with one image, UART0 and the monitor on Unix sockets in a temporary directory."""
 
-    def __init__(self, image, plugin, tick_address, mark_address, ticks, skip, directory):
+    def __init__(self, image, plugin, tick_address, mark_address, ticks, skip, directory, profile=False):
         self.directory = directory
         self.windows_path = os.path.join(directory, "windows.txt")
+        self.profile_path = os.path.join(directory, "profile.txt")
         serial_path = os.path.join(directory, "uart0.sock")
         self.monitor_path = os.path.join(directory, "monitor.sock")
         plugin_arg = (f"{plugin},tick={tick_address:#x},mark={mark_address:#x},skip={skip},ticks={ticks},"
-                      f"out={self.windows_path}")
+                      f"out={self.windows_path}" + (f",profile={self.profile_path}" if profile else ""))
         self.log = open(os.path.join(directory, "qemu.log"), "wb")
         self.process = subprocess.Popen(
             [QEMU, "-M", "mps2-an386", "-display", "none", "-nodefaults", "-icount", "shift=0,sleep=off",
@@ -171,6 +174,61 @@ def symbols(image):
     return found
 
 
+def functions(image):
+    """(start address, end address, name) of every function in the image, sorted."""
+    output = subprocess.run(["arm-none-eabi-nm", "-C", "-S", "--defined-only", image], capture_output=True,
+                            text=True, check=True).stdout
+    found = []
+    for line in output.splitlines():
+        parts = line.split(None, 3)
+        if len(parts) == 4 and parts[2] in "tTwW":
+            start = int(parts[0], 16) & ~1  # Thumb bit
+            found.append((start, start + int(parts[1], 16), parts[3]))
+    return sorted(found)
+
+
+# Double-precision arithmetic, which a Cortex-M4F (single-precision FPU) runs in software:
+# libgcc's routines and newlib's libm functions of double.
+SOFT_DOUBLE = re.compile(r"^__(aeabi_(d\w+|[ilu]+2d|f2d)|\w*df[23]|\w*df[sd]i|float\w*df|fix\w*df\w*|extendsfdf2|truncdfsf2)$"
+                         r"|^(__ieee754_\w+|__kernel_\w+|sqrt|floor|ceil|round|lround|llround|trunc|fmod|sin|cos|tan|exp|"
+                         r"log|pow|atan2?|fabs)$")
+
+
+def short_name(name):
+    """A demangled name without its parameter list and template arguments (a readable row)."""
+    depth, out = 0, []
+    name = name.replace("(anonymous namespace)", "{anonymous}")
+    for char in name.split("(")[0]:
+        if char == "<":
+            depth += 1
+        elif char == ">":
+            depth -= 1
+        elif depth == 0:
+            out.append(char)
+    return "".join(out).strip() or name
+
+
+def read_profile(path, image, ticks):
+    """Per window of the plugin's profile file: {function: instructions per tick} and
+    {function: calls per tick} (executions of the block at the function's first address)."""
+    table = functions(image)
+    starts = [start for start, _, _ in table]
+    windows = []
+    with open(path) as f:
+        for line in f:
+            if line.startswith("window"):
+                windows.append(({}, {}))
+                continue
+            address, instructions, executions = (int(field, 0) for field in line.split())
+            i = bisect.bisect_right(starts, address) - 1
+            name = short_name(table[i][2]) if i >= 0 and address < table[i][1] else f"{address:#x}"
+            per_tick, calls = windows[-1]
+            per_tick[name] = per_tick.get(name, 0) + instructions / ticks
+            if i >= 0 and address == table[i][0]:
+                calls[name] = calls.get(name, 0) + executions / ticks
+    return windows
+
+
 def section_sizes(image):
     output = subprocess.run(["arm-none-eabi-size", "-A", image], capture_output=True, text=True, check=True).stdout
     sizes = {}
@@ -181,14 +239,15 @@ def section_sizes(image):
     return sizes
 
 
-def measure(name, image, plugin, ticks, skip):
+def measure(name, image, plugin, ticks, skip, profile=False):
     spec = MODULES[name]
     found = symbols(image)
     sizes = section_sizes(image)
     result = {"module": spec["title"], "text": sizes.get(".text", 0) + sizes.get(".ARM.exidx", 0),
               "data": sizes.get(".data", 0), "bss": sizes.get(".bss", 0)}
     with tempfile.TemporaryDirectory(prefix="motwin-fw-") as directory:
-        board = Board(image, plugin, found["run_control_tick"], found["Uart0Rx_Handler"], ticks, skip, directory)
+        board = Board(image, plugin, found["run_control_tick"], found["Uart0Rx_Handler"], ticks, skip, directory,
+                      profile)
         try:
             board.request(GET_VERSION, 1)  # answers once started
             result["rest"] = board.wait_for_window(1)
@@ -209,6 +268,10 @@ def measure(name, image, plugin, ticks, skip):
             board.monitor(f"pmemsave {stack_bottom:#x} {stack_top - stack_bottom} stack.bin")
             with open(os.path.join(directory, "stack.bin"), "rb") as f:
                 stack = f.read()
+            if profile:
+                windows = read_profile(board.profile_path, image, ticks)
+                result["profile_rest"], result["calls_rest"] = windows[0]
+                result["profile_moving"], result["calls_moving"] = windows[1]
         finally:
             board.close()
     words = struct.unpack(f"<{len(stack) // 4}I", stack[: len(stack) // 4 * 4])
@@ -242,6 +305,29 @@ def markdown(results, ticks):
     return "\n".join(lines)
 
 
+def profile_markdown(results, rows):
+    """Per image: the functions that cost most of a moving tick, own instructions (not their callees')."""
+    lines = ["Where the instructions of a tick go: each function's own instructions (its callees count for "
+             "themselves) per tick, in the same windows, by qemu's translation blocks mapped to the image's "
+             "symbols.", ""]
+    for r in results:
+        moving, rest = r["profile_moving"], r["profile_rest"]
+        total = sum(moving.values())
+        soft = sum(v for k, v in moving.items() if SOFT_DOUBLE.match(k))
+        lines += [f"**{r['module']}**: {total:,.0f} instructions per moving tick, of which {soft:,.0f} "
+                  f"({100 * soft / total:.0f} %) in software double-precision arithmetic (libgcc's `__*df*` and "
+                  "`__aeabi_d*` routines, libm's functions of `double`).", "",
+                  "| function | own instructions per tick moving | share | calls per tick moving | "
+                  "own instructions per tick at rest | calls per tick at rest |",
+                  "|---|---|---|---|---|---|"]
+        for function, per_tick in sorted(moving.items(), key=lambda kv: -kv[1])[:rows]:
+            lines.append(f"| `{function}` | {per_tick:,.0f} | {100 * per_tick / total:.1f} % | "
+                         f"{r['calls_moving'].get(function, 0):,.1f} | {rest.get(function, 0):,.0f} | "
+                         f"{r['calls_rest'].get(function, 0):,.1f} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
 def build_plugin(directory):
     compiler = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
     if compiler is None:
@@ -260,6 +346,8 @@ def main():
     parser.add_argument("--skip", type=int, default=40, help="ticks after the last received byte (default 40)")
     parser.add_argument("--json", action="store_true", help="the figures as JSON instead of a table")
     parser.add_argument("--json-file", help="also write the figures as JSON to this file")
+    parser.add_argument("--profile", type=int, metavar="ROWS", default=0,
+                        help="also the ROWS functions with the most instructions per moving tick")
     args = parser.parse_args()
     for name in args.modules:
         if name not in MODULES:
@@ -279,7 +367,8 @@ def main():
     except Skip as reason:
         print(f"firmware figures skipped: {reason}")
         return SKIP_STATUS
-    results = [measure(name, image, plugin, args.ticks, args.skip) for name, image in images.items()]
+    results = [measure(name, image, plugin, args.ticks, args.skip, args.profile > 0)
+               for name, image in images.items()]
     if args.json_file:
         with open(args.json_file, "w") as f:
             json.dump(results, f, indent=1)
@@ -287,6 +376,9 @@ def main():
         print(json.dumps(results, indent=1))
     else:
         print(markdown(results, args.ticks))
+        if args.profile:
+            print()
+            print(profile_markdown(results, args.profile))
     return 0
 
 

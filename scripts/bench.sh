@@ -77,7 +77,7 @@ MOTWIN_JOBS=$jobs scripts/build-firmware.sh >"$logs/firmware-build.log" 2>&1 ||
 firmware_ticks=2000
 [ $quick = 1 ] && firmware_ticks=500
 status=0
-/usr/bin/python3 bench/firmware_figures.py --ticks $firmware_ticks --json-file "$logs/firmware_figures.json" \
+/usr/bin/python3 bench/firmware_figures.py --ticks $firmware_ticks --profile 12 --json-file "$logs/firmware_figures.json" \
   >"$logs/firmware_figures.txt" 2>"$logs/firmware_figures.err" || status=$?
 if [ $status != 0 ] && [ $status != 77 ]; then
   log "bench/firmware_figures.py failed (exit status $status); its output is in $logs/"

@@ -8,7 +8,10 @@ and while moving, and the painted stack is read back.
   image would fall behind its own ticks), the count while moving above it (the ramp generator
   runs), min <= mean <= max;
 - the stack's high-water mark above nothing and below the stack region (the paint was found);
-- flash and RAM from the image's sections.
+- flash and RAM from the image's sections;
+- the profile (--profile): per window, the functions' instructions add up to the window's mean
+  (the plugin counts the same blocks twice, once per address), the tick function is in both
+  windows and the motion code only in the moving one costs more than at rest.
 The figures themselves are not asserted (bench/ reports them).
 
 Skipped, visibly (exit status 77), as integration/test_firmware_qemu.py is: qemu-system-arm not
@@ -41,7 +44,8 @@ def test_figures_of_both_images(motwin):
         if (shutil.which("qemu-system-arm") and shutil.which("arm-none-eabi-g++")
                 and not os.path.exists(os.path.join(FIRMWARE_DIR, f"{name}.elf"))):
             raise TestFailure(f"{FIRMWARE_DIR}/{name}.elf is missing: run scripts/build-firmware.sh")
-    result = subprocess.run([sys.executable, TOOL, "--json", "--ticks", str(TICKS), "--firmware-dir", FIRMWARE_DIR],
+    result = subprocess.run([sys.executable, TOOL, "--json", "--profile", "5", "--ticks", str(TICKS),
+                             "--firmware-dir", FIRMWARE_DIR],
                             capture_output=True, text=True, timeout=500)
     if result.returncode == SKIP_STATUS:
         raise Skipped(result.stdout.strip())
@@ -60,6 +64,17 @@ def test_figures_of_both_images(motwin):
               f"{what}: stack high-water mark {image['stack_used']} of {image['stack_used'] + image['stack_free']}")
         check(image["stack_free"] >= 8192, f"{what}: less than the linker script's 8 KiB of stack left")
         check(image["text"] > 10_000 and image["bss"] > 10_000, f"{what}: sections {image}")
+        for window, profile in ((rest, image["profile_rest"]), (moving, image["profile_moving"])):
+            total = sum(profile.values())
+            # One translation block at each end of the window may fall on either side.
+            check(abs(total - window["mean"]) <= 0.01 * window["mean"],
+                  f"{what}: the profile's {total:.1f} instructions per tick against the window's {window['mean']}")
+            check(profile.get("void motwin::firmware::mps2_an386::run_control_tick", 0) > 0,
+                  f"{what}: run_control_tick not in the profile {sorted(profile)[:20]}")
+        motion = [function for function in image["profile_moving"] if "motion::" in function]
+        check(motion, f"{what}: no motion:: function while moving")
+        check(sum(image["profile_moving"][f] for f in motion) > sum(image["profile_rest"].get(f, 0) for f in motion),
+              f"{what}: the motion code costs no more while moving")
 
 
 if __name__ == "__main__":

@@ -51,6 +51,18 @@ class ModuleStorage : public TmclDevice {
     constexpr NvmLayout layout = Derived::kNvmLayout;
     std::memset(image, 0, size);
     if (size < layout.total_size) return;
+    format_factory_parameters(image, axis_table);
+    for (uint32_t address = 0; address < layout.program_capacity; ++address) {
+      encode_program_record(Instruction{command::kStop, 0, 0, 0},
+                            image + layout.program_offset + address * kProgramRecordBytes);
+    }
+  }
+
+  // The part before the program (parameters, user variables, coordinates) at factory values:
+  // layout.program_offset bytes.
+  static void format_factory_parameters(uint8_t* image, const params::ParameterTable<Derived>& axis_table) {
+    constexpr NvmLayout layout = Derived::kNvmLayout;
+    std::memset(image, 0, layout.program_offset);
     for (const auto& row : axis_table.rows()) {
       if (!is_stored_parameter(row.info)) continue;
       for (uint8_t motor = 0; motor < Derived::kMotorCount; ++motor) {
@@ -62,10 +74,6 @@ class ModuleStorage : public TmclDevice {
       if (!is_stored_parameter(row.info)) continue;
       put_le32(image + layout.global_parameter(static_cast<uint8_t>(row.info.number)),
                static_cast<int32_t>(row.info.default_value));
-    }
-    for (uint32_t address = 0; address < layout.program_capacity; ++address) {
-      encode_program_record(Instruction{command::kStop, 0, 0, 0},
-                            image + layout.program_offset + address * kProgramRecordBytes);
     }
   }
 
@@ -209,9 +217,11 @@ class ModuleStorage : public TmclDevice {
   // back to factory values; a stored TMCL program is kept (docs/decisions.md). The engine
   // powers the module up afterwards.
   void restore_factory_defaults() override {
-    static uint8_t image[Derived::kNvmLayout.total_size];
-    format_factory_image(image, sizeof image, derived().axis_table());
-    last_store_failed_ = !nvm_.write(0, image, Derived::kNvmLayout.program_offset);
+    // Only the part that is rewritten, in one write (atomic); static, so that the firmware's RAM
+    // use is known at link time rather than at the deepest stack.
+    static uint8_t parameters[Derived::kNvmLayout.program_offset];
+    format_factory_parameters(parameters, derived().axis_table());
+    last_store_failed_ = !nvm_.write(0, parameters, sizeof parameters);
   }
 
   // Default hooks; Derived hides the ones it needs.
