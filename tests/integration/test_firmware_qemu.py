@@ -9,6 +9,9 @@ the host tools talk to it as to a module on a serial line (docs/firmware.md).
   outside the image, so it keeps its contents), the RAM value lost;
 - a program downloaded and started with `motwin download`/`start`, and started again by itself
   after a reset (stored in the EEPROM image, GP 77);
+- the TMCM-1636 image of firmware 1.13 (tmcm1636_v113.elf, the generation PyTrinamic's TMCM1636
+  class targets): its version, its own axis parameters (AP 7 gone, AP 26 and 56 there) and an
+  MVP in the units of its position scaler;
 - the TMCM-142 image: an MVP, and a GAP as an ASCII line after command 139.
 
 Skipped, visibly (exit status 77), when qemu-system-arm is not installed, or when the ARM
@@ -199,6 +202,23 @@ def test_stored_program_runs_and_autostarts_after_a_reset(motwin):
                         MOVE_TIMEOUT)
 
 
+def test_tmcm1636_v113_image(motwin):
+    image = firmware_image("tmcm1636_v113")
+    with TempDir() as state, EmulatedBoard(image, state) as board:
+        client = board.client
+        check_equal(client.version_string(), b"1636V113", "command 136 type 0")
+        expect_reply(client.request(GET_VERSION, 1), GET_VERSION, value=0x0664010D, what="command 136 type 1 (1636, 1, 13)")
+        expect_reply(client.request(GAP, 7), GAP, STATUS_WRONG_TYPE, what="GAP 7 (dual shunt factor, gone in 1.13)")
+        check_equal(client.gap(26), 0, "GAP 26 (velocity sensor selection, new in 1.13)")
+        check_equal(client.gap(56), 65536, "GAP 56 (position scaler, new in 1.13) factory default")
+        client.sap(56, 1000)
+        expect_reply(client.request(MVP, MVP_ABS, 0, 250), MVP, STATUS_OK, what="MVP ABS 250")
+        client.wait_for("GAP 55 (position reached)", lambda: client.gap(55) == 1, MOVE_TIMEOUT, interval=0.05)
+        check_equal(client.gap(50), 250, "GAP 50 (target position, in position scaler units)")
+        position = client.gap(52)
+        check(abs(position - 250) <= 1, f"GAP 52 (actual position) {position}, not within 1 of 250")
+
+
 def test_tmcm142_moves_and_speaks_ascii(motwin):
     image = firmware_image("tmcm142")
     with TempDir() as state, EmulatedBoard(image, state) as board:
@@ -226,4 +246,5 @@ def test_tmcm142_moves_and_speaks_ascii(motwin):
 
 if __name__ == "__main__":
     run_tests([test_version_and_parameters, test_mvp_reaches_target, test_stap_survives_a_board_reset,
-               test_stored_program_runs_and_autostarts_after_a_reset, test_tmcm142_moves_and_speaks_ascii])
+               test_stored_program_runs_and_autostarts_after_a_reset, test_tmcm1636_v113_image,
+               test_tmcm142_moves_and_speaks_ascii])

@@ -1,7 +1,10 @@
 // The TMCM-1636 firmware on the MPS2 AN386 board (qemu-system-arm -M mps2-an386): the core's
 // module with the ideal motor (no power stage attached: the axis follows its ramp generator,
 // core/modules/tmcm1636/tmcm1636_axis.h), its EEPROM image in the board's flash region, TMCL on
-// UART0 and a 50 µs SysTick control tick (docs/firmware.md).
+// UART0 and a 50 µs SysTick control tick (docs/firmware.md). Built twice, as a real module is
+// flashed with one firmware generation: tmcm1636.elf is 1636V109 (the manual's),
+// tmcm1636_v113.elf is 1636V113 (what PyTrinamic's TMCM1636 class targets), chosen by
+// MOTWIN_TMCM1636_FIRMWARE (src/firmware/CMakeLists.txt).
 #include <cstdint>
 
 #include "board/modules/tmcm1636/tmcm1636_io.h"
@@ -38,6 +41,11 @@ class BenchIo final : public board::Tmcm1636Io {
   uint32_t outputs_ = 0;
 };
 
+#ifndef MOTWIN_TMCM1636_FIRMWARE
+#define MOTWIN_TMCM1636_FIRMWARE kV109
+#endif
+constexpr hw::Firmware kFirmware = hw::Firmware::MOTWIN_TMCM1636_FIRMWARE;
+
 using Eeprom = firmware::BankedNvm<Tmcm1636::kNvmLayout.total_size>;
 __attribute__((section(".eeprom"))) uint8_t g_eeprom_region[Eeprom::kRegionSize];
 
@@ -49,8 +57,10 @@ an386::Uart0Output g_uart;
 
 extern "C" [[noreturn]] void firmware_main() {
   an386::uart0_init(an386::kDefaultBaud);
-  g_eeprom.open([](uint8_t* image, size_t size) { Tmcm1636::format_factory_image(image, size); });
+  g_eeprom.open([](uint8_t* image, size_t size) {
+    Tmcm1636::format_factory_image(image, size, Tmcm1636::axis_parameters(kFirmware));
+  });
   // Constructed once the image is open: the module reads it at power-up.
-  static Tmcm1636 module(g_eeprom, g_io);
+  static Tmcm1636 module(g_eeprom, g_io, kFirmware);
   an386::run_tmcl_module(module, g_uart);
 }
