@@ -12,7 +12,9 @@ the host tools talk to it as to a module on a serial line (docs/firmware.md).
 - the TMCM-1636 image of firmware 1.13 (tmcm1636_v113.elf, the generation PyTrinamic's TMCM1636
   class targets): its version, its own axis parameters (AP 7 gone, AP 26 and 56 there) and an
   MVP in the units of its position scaler;
-- the TMCM-142 image: an MVP, and a GAP as an ASCII line after command 139.
+- the TMCM-142 image: an MVP, and a GAP as an ASCII line after command 139; an ASCII session of
+  several lines in one write (echo, replies in order, status 2 and 4 for bad lines, another
+  module's line ignored, LF as a line end, echo switched off by GP 67).
 
 Skipped, visibly (exit status 77), when qemu-system-arm is not installed, or when the ARM
 toolchain is not installed and so no image was built. With the toolchain installed a missing
@@ -244,7 +246,34 @@ def test_tmcm142_moves_and_speaks_ascii(motwin):
         check_equal(client.gap(1), 5000, "binary GAP 1 after BIN")
 
 
+def read_exactly(client, expected, what):
+    received = b""
+    while len(received) < len(expected):
+        more = client.read_available(5.0)
+        check(more != b"", f"{what}: got only {received!r} of {expected!r}")
+        received += more
+    check_equal(received, expected, what)
+
+
+def test_tmcm142_ascii_session(motwin):
+    """Lines are read and answered one at a time (docs/ascii-mode.md), even when they arrive in
+    one write: each echo follows the previous line's reply."""
+    image = firmware_image("tmcm142")
+    with TempDir() as state, EmulatedBoard(image, state) as board:
+        client = board.client
+        expect_reply(client.request(ENTER_ASCII, 0), ENTER_ASCII, STATUS_OK, what="command 139")
+        lines = [b"ASAP 4, 0, 1234\r", b"AGAP 4, 0\r", b"AFOO 1\r", b"AGAP 4,,0\r", b"BGAP 4, 0\r",
+                 b"a gap 4 0\n"]
+        client.send_raw(b"".join(lines))
+        read_exactly(client, b"ASAP 4, 0, 1234\rBA 100 1234\r" b"AGAP 4, 0\rBA 100 1234\r"
+                     b"AFOO 1\rBA 2 0\r" b"AGAP 4,,0\rBA 4 0\r" b"a gap 4 0\nBA 100 1234\r",
+                     "echo and reply of each line in turn (the line for module B neither echoed nor answered)")
+        # GP 67 bit 5: no echo from the next character on (the line that sets it is echoed).
+        client.send_raw(b"ASGP 67, 0, 32\rAGAP 4, 0\r")
+        read_exactly(client, b"ASGP 67, 0, 32\rBA 100 32\rBA 100 1234\r", "echo off after SGP 67, 0, 32")
+
+
 if __name__ == "__main__":
     run_tests([test_version_and_parameters, test_mvp_reaches_target, test_stap_survives_a_board_reset,
                test_stored_program_runs_and_autostarts_after_a_reset, test_tmcm1636_v113_image,
-               test_tmcm142_moves_and_speaks_ascii])
+               test_tmcm142_moves_and_speaks_ascii, test_tmcm142_ascii_session])
