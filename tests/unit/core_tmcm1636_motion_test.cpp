@@ -184,6 +184,34 @@ TEST(Tmcm1636Motion, position_event_138_fires_once_when_the_target_is_reached) {
   EXPECT_EQ(sink.replies.size(), 1u) << "one event per request";
 }
 
+// The ramp limits in counts/s are derived only when AP 43, 44 or 100 change: each change
+// still takes effect in the next tick.
+TEST(Tmcm1636Motion, ramp_limits_follow_ap43_ap44_and_ap100_changed_mid_move) {
+  Tmcm1636Rig rig;
+  rig.command(1, 0, 0, 1500);
+  rig.run_ms(1000);
+  ASSERT_EQ(rig.gap(42), 1500);
+  rig.command(5, 43, 0, 700);  // max velocity below the target: down at 2000 rpm/s in 0.4 s
+  rig.run_ms(200);
+  EXPECT_NEAR(rig.gap(42), 1100, 1);
+  rig.run_ms(300);
+  EXPECT_EQ(rig.gap(42), 700);
+  // Fewer counts per revolution: the ramp's 700 rpm of 8192 counts are now above 700 rpm of
+  // 4000, so it brakes (2000 rpm/s of 4000 counts: 0.37 s) to the same rpm in fewer counts/s.
+  rig.command(5, 100, 0, 4000);
+  rig.run_ms(500);
+  const int32_t start = rig.gap(52);
+  rig.run_ms(600);
+  EXPECT_EQ(rig.gap(42), 700);
+  EXPECT_NEAR(rig.gap(52) - start, 700.0 * 4000.0 / 60.0 * 0.6, 2.0);
+  rig.command(5, 44, 0, 9000);
+  rig.command(5, 43, 0, 3000);  // up to the target at 9000 rpm/s: 800 rpm in 89 ms
+  rig.run_ms(45);
+  EXPECT_NEAR(rig.gap(42), 1105, 1);
+  rig.run_ms(50);
+  EXPECT_EQ(rig.gap(42), 1500);
+}
+
 TEST(Tmcm1636Motion, same_inputs_give_the_same_trajectory_bit_for_bit) {
   auto trajectory = [] {
     Tmcm1636Rig rig;

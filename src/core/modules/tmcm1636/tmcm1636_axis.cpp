@@ -15,13 +15,32 @@ int32_t round_to_int32(double v) {
 
 }  // namespace
 
+// A zero product is its own quotient (AP 100 is never negative): a standing axis skips the
+// division, which a Cortex-M4F does in software (docs/firmware.md, "Where a tick's
+// instructions go").
 double Tmcm1636Axis::counts_per_second(double velocity_rpm) const {
-  return velocity_rpm * static_cast<double>(config.encoder_steps) / 60.0;
+  const double product = velocity_rpm * static_cast<double>(config.encoder_steps);
+  return product == 0.0 ? product : product / 60.0;
 }
 
 double Tmcm1636Axis::rpm(double counts_per_second) const {
   if (config.encoder_steps == 0) return 0.0;
-  return counts_per_second * 60.0 / static_cast<double>(config.encoder_steps);
+  const double product = counts_per_second * 60.0;
+  return product == 0.0 ? product : product / static_cast<double>(config.encoder_steps);
+}
+
+const motion::TrapezoidRampConfig& Tmcm1636Axis::ideal_ramp_config() {
+  IdealRampLimits& limits = ideal_ramp_limits_;
+  if (limits.max_velocity_rpm != config.max_velocity_rpm ||
+      limits.acceleration_rpm_per_s != config.acceleration_rpm_per_s || limits.encoder_steps != config.encoder_steps) {
+    limits.max_velocity_rpm = config.max_velocity_rpm;
+    limits.acceleration_rpm_per_s = config.acceleration_rpm_per_s;
+    limits.encoder_steps = config.encoder_steps;
+    limits.ramp.max_velocity = counts_per_second(config.max_velocity_rpm);
+    limits.ramp.acceleration = counts_per_second(config.acceleration_rpm_per_s);
+  }
+  limits.ramp.ramp_enabled = config.velocity_ramp_enabled != 0;
+  return limits.ramp;
 }
 
 // A servo starts a new mode from the motion it measures, so that a mode change is bumpless.
@@ -137,14 +156,9 @@ void Tmcm1636Axis::ideal_tick(const board::Tmcm1636Io& io, double dt_s) {
   if (io.reference_switch_level(board::ReferenceSwitch::kHome)) levels |= 4;
   update_switches(levels);
   if (state.driver_enabled != 0 && state.mode != MotionMode::kTorque) {
-    const motion::TrapezoidRampConfig ramp_config{
-        counts_per_second(config.max_velocity_rpm),
-        counts_per_second(config.acceleration_rpm_per_s),
-        config.velocity_ramp_enabled != 0,
-    };
     // Re-derived every tick: AP 100 (counts per revolution) may have changed.
     if (state.mode == MotionMode::kVelocity) ramp_.set_velocity_target(counts_per_second(state.target_velocity_rpm));
-    ramp_.step(ramp_config, dt_s);
+    ramp_.step(ideal_ramp_config(), dt_s);
     // An enabled reference switch stops motion towards it at once (AP 209).
     if (switch_blocks(ramp_.velocity())) stop_at_switch();
   }

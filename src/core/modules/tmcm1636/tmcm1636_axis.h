@@ -363,7 +363,18 @@ class Tmcm1636Axis {
   double to_rpm(double counts_per_s) const { return counts_per_s * rpm_per_count_per_s_; }
   double to_counts_per_s(double velocity_rpm) const { return velocity_rpm * counts_per_s_per_rpm_; }
 
+  // The ideal motor's ramp limits in counts/s, derived again only when AP 43, 44 or 100 changed
+  // (two divisions less in every tick; docs/firmware.md, "Where a tick's instructions go").
+  struct IdealRampLimits {
+    int32_t max_velocity_rpm = 0;
+    int32_t acceleration_rpm_per_s = 0;
+    int32_t encoder_steps = -1;  // never a value of AP 100: the first tick derives the limits
+    motion::TrapezoidRampConfig ramp;
+  };
+  const motion::TrapezoidRampConfig& ideal_ramp_config();
+
   motion::TrapezoidRamp ramp_;
+  IdealRampLimits ideal_ramp_limits_;
   Servo servo_;
   double rpm_per_count_per_s_ = 60.0 / 8192.0;
   double counts_per_s_per_rpm_ = 8192.0 / 60.0;
