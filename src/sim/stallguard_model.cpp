@@ -61,6 +61,12 @@ void StallGuardModel::update(const StepperPlant& plant, const board::StepperDriv
   update_with_load(drive, load_term(sin_delta, cos_delta), plant.electrical_angle_rad(), present, settings, dt_s);
 }
 
+bool StallGuardModel::standstill_settled() const {
+  // A skipped tick of length dt would have lengthened still_s_ and compared still_s_ + dt with
+  // kPauseS + dt / 2, false for any dt once still_s_ >= kPauseS; window_s_ stays as it is.
+  return started_ && still_s_ >= kPauseS;
+}
+
 void StallGuardModel::update_ideal(const board::StepperDrive& drive, const StallGuardSettings& settings,
                                    double dt_s) {
   // The rotor is where the field is: its angle is the sequencer's (continuous once started).

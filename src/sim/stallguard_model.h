@@ -76,6 +76,13 @@ class StallGuardModel {
   // Back to the power-on state: results 0, filters empty, the sequencer tracking restarts.
   void reset();
 
+  // A powered motor's standstill has lasted the whole pause that counts (20 ms): further ticks of
+  // the same standstill (the field not moving, any tick length) change nothing that is ever read
+  // again. They only lengthen the pause, which is only compared with that limit, which it has
+  // passed, and which restarts from 0 when the field moves. The sim board rests such a motor
+  // (docs/tmcm-3216-drive.md "Idle ticks").
+  bool standstill_settled() const;
+
  private:
   // The core of all three: the load's share of the available torque this tick (sin of the load angle
   // δ within ±90°, else ±1: load_term()) and the rotor's continuous electrical angle (rad).

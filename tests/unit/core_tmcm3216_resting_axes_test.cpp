@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "support/tmcm3216_board_rig.h"
 
@@ -52,6 +53,12 @@ void expect_same(const Tmcm3216BoardRig& resting, const Tmcm3216BoardRig& full, 
     ASSERT_EQ(sa.switches().raw, sb.switches().raw) << when;
     ASSERT_EQ(sa.driver_error_flags(), sb.driver_error_flags()) << when;
     ASSERT_EQ(resting.board.rotor_revolutions(axis), full.board.rotor_revolutions(axis)) << when;
+    const std::string speed = "AXIS" + std::to_string(axis) + "_SPEED_RPM";
+    ASSERT_EQ(resting.board.read_signal(speed), full.board.read_signal(speed)) << when;
+    const sim::StallGuardModel& ga = resting.board.stallguard(axis);
+    const sim::StallGuardModel& gb = full.board.stallguard(axis);
+    ASSERT_EQ(ga.last_load_fraction(), gb.last_load_fraction()) << when << ", axis " << int{axis};
+    ASSERT_EQ(ga.last_full_steps_per_s(), gb.last_full_steps_per_s()) << when << ", axis " << int{axis};
   }
   ASSERT_EQ(constant(resting).error_register(), constant(full).error_register()) << when;
 }
@@ -163,7 +170,9 @@ TEST(Tmcm3216RestingAxes, a_powered_axis_at_standstill_rests_and_its_standby_cur
   EXPECT_TRUE(resting.stepper(0).standby());
   EXPECT_LT(resting.stepper(0).current_ma(), run_current_ma);
   EXPECT_TRUE(resting.axis_resting(0)) << "at the standby current it rests again";
-  // A move wakes it; at the target it rests again and the standby delay starts anew.
+  EXPECT_TRUE(rigs.resting.board.axis_resting(0)) << "the board rests a powered motor standing past the pause";
+  // A move wakes it; at the target it rests again and the standby delay starts anew. The first
+  // StallGuard measurements after the standstill are the same with the board's resting ticks.
   rigs.write(0x6081, 20000);
   rigs.write(0x607A, 2000);
   rigs.write(0x6040, 0x1F);
@@ -172,7 +181,26 @@ TEST(Tmcm3216RestingAxes, a_powered_axis_at_standstill_rests_and_its_standby_cur
   rigs.ticks(20000, "standing again");
   EXPECT_TRUE(resting.stepper(0).standby());
   EXPECT_TRUE(resting.axis_resting(0));
+  EXPECT_TRUE(rigs.resting.board.axis_resting(0));
   EXPECT_EQ(resting.drive(0).position_actual(), 2000);
+  // Slow moves (below the StallGuard fade speed) after a standstill that the board rested, in
+  // StealthChop with its filter and in SpreadCycle with the four-step filter: the first full
+  // step after the pause measures as with every tick a full one.
+  rigs.write(0x6081, 3000);
+  rigs.write(0x20B0, 100000);  // StealthChop below this speed while 20B1 is not 0
+  for (const auto& [stealth_chop, position] : {std::pair{true, 2600}, std::pair{false, 2000}}) {
+    rigs.write(0x20B1, stealth_chop ? 20 : 0);
+    rigs.write(stealth_chop ? 0x20A9 : 0x209D, 1);  // the StallGuard4 / StallGuard2 filter
+    rigs.ticks(600, "chopper set");
+    rigs.write(0x607A, position);
+    rigs.write(0x6040, 0x1F);
+    rigs.ticks(8000, "a slow move");
+    EXPECT_EQ(resting.drive(0).position_actual(), position);
+    rigs.write(0x6040, 0x0F);
+    rigs.ticks(12000, "standing through the standby delay and ramp");
+    EXPECT_TRUE(rigs.resting.board.axis_resting(0));
+  }
+  EXPECT_GT(rigs.resting.board.stallguard(0).measurements(), 0u);
 }
 
 // Each way in, on a resting axis: the change shows in the very next tick.

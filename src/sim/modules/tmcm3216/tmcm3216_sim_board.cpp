@@ -256,12 +256,15 @@ void Tmcm3216SimBoard::after_tick(double dt_s) {
     a.ideal.advance(drive, dt_s);
     a.stallguard.update_ideal(drive, settings, dt_s);
     // Rests from here: the drive seen before this tick (applied by the previous after_tick) and
-    // now is the same, with the bridges off. Then the motor holds its position at velocity 0 and
-    // the StallGuard model stays reset (count kept) whatever it was, and sensing the same rotor
-    // with the same inputs again gives the same feedback (the N-pulse and filter bookkeeping
-    // caught up in this tick's sensing), so the next ticks change nothing. Without a signal set
-    // or a rotor moved in between, and with this tick's feedback the same as the last one.
-    resting_[axis] = sensed && resting_enabled_ && !touched_ && !stage.drive.enabled &&
+    // now is the same, with the bridges off, or on with the standstill settled in the StallGuard
+    // model. Then the motor holds its position at velocity 0 (a powered one: this tick moved it
+    // by the same field angle as the last, by nothing) and the StallGuard model stays reset
+    // (count kept) whatever it was, or holds its results while the standstill lengthens
+    // (StallGuardModel::standstill_settled), and sensing the same rotor with the same inputs
+    // again gives the same feedback (the N-pulse and filter bookkeeping caught up in this tick's
+    // sensing), so the next ticks change nothing. Without a signal set or a rotor moved in
+    // between, and with this tick's feedback the same as the last one.
+    resting_[axis] = sensed && resting_enabled_ && !touched_ && (!drive.enabled || a.stallguard.standstill_settled()) &&
                      stage.drive == drive_before_[axis] && stage.feedback == feedback_before_[axis];
     resting_drive_[axis] = stage.drive;
     resting_feedback_[axis] = stage.feedback;

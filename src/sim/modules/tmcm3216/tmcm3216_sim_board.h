@@ -60,9 +60,10 @@ class Tmcm3216SimBoard final : public LoggingSignalBoard {
   // Around each control tick of the firmware.
   void before_tick();
   void after_tick(double dt_s);
-  // Whether an axis with the ideal motor rests: its bridges were off through its last two full
-  // ticks with the same drive, which leaves sensing, motor and StallGuard model as they are, so
-  // the next ticks with the same drive and inputs are skipped (docs/tmcm-3216-drive.md "Idle ticks").
+  // Whether an axis with the ideal motor rests: its last two full ticks had the same drive, with
+  // the bridges off or with a powered motor standing past the StallGuard pause, which leaves
+  // sensing, motor and StallGuard model as they are, so the next ticks with the same drive and
+  // inputs are skipped (docs/tmcm-3216-drive.md "Idle ticks").
   bool axis_resting(uint8_t axis) const { return resting_[axis]; }
   // Tests: false makes every tick a full one.
   void set_resting_axes_enabled(bool enabled) {
