@@ -50,7 +50,7 @@ constexpr uint16_t kControlwords[] = {0x0006, 0x0007, 0x000F, 0x0000, 0x0002, 0x
                                       0x001F, 0x000F, 0x010F, 0x005F, 0x003F, 0x000B, 0x008F};
 constexpr int8_t kModes[] = {1, 3, 6, 8, 9, 0, -1, 2, 7};
 
-bool drive_function_disabled(PdsState state) {
+FUZZ_UNTRACED bool drive_function_disabled(PdsState state) {
   return state == PdsState::kNotReadyToSwitchOn || state == PdsState::kSwitchOnDisabled ||
          state == PdsState::kReadyToSwitchOn || state == PdsState::kSwitchedOn || state == PdsState::kFault;
 }
@@ -100,6 +100,38 @@ can::CanFrame sdo_download(Tmcm3216& device, uint16_t index, uint8_t sub, int64_
   const auto bits = static_cast<uint64_t>(value);
   for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
   return frame;
+}
+
+// Up to `ticks` motion ticks of module and board within the input's budget, with the
+// motor-standstill invariant checked around each: an axis whose PDS state has the drive
+// function disabled before and after a tick does not move its motor. The loop and the checks are
+// left out of libFuzzer's tracing (FUZZ_UNTRACED: their comparisons of loop counters, states and
+// angles, a tenth of the target's time, guide nothing; the module's and the board's ticks stay as
+// they are). The states are read through the const accessors: the mutable ones wake resting axes
+// (a full tick each).
+FUZZ_UNTRACED void run_ticks(Tmcm3216& device, sim::Tmcm3216SimBoard& board, int ticks, int& ticks_left) {
+  const Tmcm3216& view = device;
+  const board::Tmcm3216Board& stages = std::as_const(board).board();
+  const modules::tmcm3216::Tmcm3216Drive* drives[kAxes];
+  for (uint8_t axis = 0; axis < kAxes; ++axis) drives[axis] = &view.drive(axis);
+  for (int i = 0; i < ticks && ticks_left > 0; ++i, --ticks_left) {
+    PdsState before[kAxes];
+    uint32_t angle[kAxes];
+    for (uint8_t axis = 0; axis < kAxes; ++axis) {
+      before[axis] = drives[axis]->state();
+      angle[axis] = stages.axes[axis].drive.electrical_angle;
+    }
+    board.before_tick();
+    device.tick();
+    board.after_tick(modules::tmcm3216::kTickUs * 1e-6);
+    for (uint8_t axis = 0; axis < kAxes; ++axis) {
+      const PdsState after = drives[axis]->state();
+      if (drive_function_disabled(before[axis]) && drive_function_disabled(after) &&
+          stages.axes[axis].drive.electrical_angle != angle[axis]) {
+        FUZZ_CHECK(false, "axis %u moved its motor in PDS state %d", axis, static_cast<int>(after));
+      }
+    }
+  }
 }
 
 // The module on its sim board, on a RAM EEPROM with the factory image, powered up; one per input
@@ -232,25 +264,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         send = false;
         const int ticks = in.ConsumeIntegralInRange<int>(1, 1000);
         client.before(nullptr, static_cast<uint32_t>(std::min(ticks, ticks_left)) * modules::tmcm3216::kTickUs);
-        // Read through the const accessors: the mutable ones wake resting axes (a full tick each).
-        const Tmcm3216& view = *device;
-        for (int i = 0; i < ticks && ticks_left > 0; ++i, --ticks_left) {
-          PdsState before[kAxes];
-          uint32_t angle[kAxes];
-          for (uint8_t axis = 0; axis < kAxes; ++axis) {
-            before[axis] = view.drive(axis).state();
-            angle[axis] = board->board().axes[axis].drive.electrical_angle;
-          }
-          board->before_tick();
-          device->tick();
-          board->after_tick(modules::tmcm3216::kTickUs * 1e-6);
-          for (uint8_t axis = 0; axis < kAxes; ++axis) {
-            if (drive_function_disabled(before[axis]) && drive_function_disabled(view.drive(axis).state())) {
-              FUZZ_CHECK(board->board().axes[axis].drive.electrical_angle == angle[axis],
-                         "axis %u moved its motor in PDS state %d", axis, static_cast<int>(view.drive(axis).state()));
-            }
-          }
-        }
+        run_ticks(*device, *board, ticks, ticks_left);
         break;
       }
     }
