@@ -30,10 +30,9 @@ bool is_slave_answer(uint8_t cs) {
 
 uint32_t identity(fuzz::Tmcm3216& device, uint8_t sub) {
   canopen::ObjectRef ref;
-  if (device.dictionary().find(0x1018, sub, ref) != canopen::SdoAbort::kNone) return 0;
+  if (!fuzz::ObjectLookup::of(device).find(0x1018, sub, ref)) return 0;
   uint8_t bytes[8] = {};
-  size_t length = 0;
-  device.dictionary().read(ref, bytes, sizeof(bytes), length);
+  fuzz::read_numeric(device, ref, bytes);
   return fuzz::le32(bytes);
 }
 

@@ -32,19 +32,8 @@ struct Target {
 
 class PdoFuzzer {
  public:
-  PdoFuzzer(FuzzedDataProvider& in, fuzz::Tmcm3216Rig& rig) : in_(in), rig_(rig), device_(*rig.device) {
-    for (const auto& row : device_.dictionary().rows()) {
-      const uint8_t axes = row.info.axis_stride == 0 ? 1 : device_.dictionary().axis_count();
-      for (uint8_t axis = 0; axis < axes; ++axis) {
-        const auto index = static_cast<uint16_t>(row.info.index + axis * row.info.axis_stride);
-        if (is_pdo_parameter(index)) pdo_parameters_.push_back({index, row.info.sub});
-        if (row.info.pdo_mappable && canopen::is_numeric(row.info.type)) {
-          mappable_.push_back(static_cast<uint32_t>(index) << 16 | static_cast<uint32_t>(row.info.sub) << 8 |
-                              canopen::type_size(row.info.type) * 8u);
-        }
-      }
-    }
-  }
+  PdoFuzzer(FuzzedDataProvider& in, fuzz::Tmcm3216Rig& rig)
+      : in_(in), rig_(rig), device_(*rig.device), tables_(Tables::of(device_)) {}
 
   void run() {
     for (int step = 0; step < 160 && in_.remaining_bytes() > 0; ++step) {
@@ -70,12 +59,15 @@ class PdoFuzzer {
                              : in_.ConsumeIntegral<uint32_t>();
   }
 
+  // A PDO communication parameter (numeric, readable) through the checks' untraced lookup.
   uint32_t read_u32(uint16_t index, uint8_t sub) {
     canopen::ObjectRef ref;
-    if (device_.dictionary().find(index, sub, ref) != canopen::SdoAbort::kNone) return 0;
+    if (!fuzz::ObjectLookup::of(device_).find(index, sub, ref) || !canopen::readable(ref.info->access) ||
+        !canopen::is_numeric(ref.info->type)) {
+      return 0;
+    }
     uint8_t bytes[8] = {};
-    size_t length = 0;
-    if (device_.dictionary().read(ref, bytes, sizeof(bytes), length) != canopen::SdoAbort::kNone) return 0;
+    fuzz::read_numeric(device_, ref, bytes);
     return fuzz::le32(bytes);
   }
 
@@ -197,12 +189,39 @@ class PdoFuzzer {
     deliver(frame, [](const can::CanFrame&) {});
   }
 
+  // The PDO parameters and the mappable objects of the dictionary: the object table is constant,
+  // so they are listed once per process.
+  struct Tables {
+    std::vector<Target> pdo_parameters;
+    std::vector<uint32_t> mappable;
+
+    static const Tables& of(fuzz::Tmcm3216& device) {
+      static const Tables tables = [&device] {
+        Tables t;
+        for (const auto& row : device.dictionary().rows()) {
+          const uint8_t axes = row.info.axis_stride == 0 ? 1 : device.dictionary().axis_count();
+          for (uint8_t axis = 0; axis < axes; ++axis) {
+            const auto index = static_cast<uint16_t>(row.info.index + axis * row.info.axis_stride);
+            if (is_pdo_parameter(index)) t.pdo_parameters.push_back({index, row.info.sub});
+            if (row.info.pdo_mappable && canopen::is_numeric(row.info.type)) {
+              t.mappable.push_back(static_cast<uint32_t>(index) << 16 | static_cast<uint32_t>(row.info.sub) << 8 |
+                                   canopen::type_size(row.info.type) * 8u);
+            }
+          }
+        }
+        return t;
+      }();
+      return tables;
+    }
+  };
+
   FuzzedDataProvider& in_;
   fuzz::Tmcm3216Rig& rig_;
   fuzz::Tmcm3216& device_;
+  const Tables& tables_;
+  const std::vector<Target>& pdo_parameters_ = tables_.pdo_parameters;
+  const std::vector<uint32_t>& mappable_ = tables_.mappable;
   fuzz::SdoClientView client_{device_};
-  std::vector<Target> pdo_parameters_;
-  std::vector<uint32_t> mappable_;
 };
 
 }  // namespace
