@@ -38,7 +38,7 @@ inline uint16_t crc16_bitwise(const uint8_t* data, size_t length) {
 // The objects of the TMCM-3216's dictionary by index and sub-index, for the checks' own lookups:
 // what TableDictionary::find answers, from a table sorted once per process (the rows and the axis
 // count are constants) and searched without libFuzzer's tracing. Looking up through find() for
-// every snapshot and read-back of the SDO client view was a sixth of canopen_pdo's time; the
+// every snapshot and read-back of the SDO client view was a seventh of canopen_pdo's time; the
 // server's own lookups stay find(). The table is checked when it is built: every entry is what
 // find() gives, and every index and sub-index that find() knows is in it.
 class ObjectLookup {
