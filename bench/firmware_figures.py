@@ -37,7 +37,9 @@ import time
 
 SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PLUGIN_SOURCE = os.path.join(SOURCE_DIR, "bench", "firmware", "qemu_tick_count.c")
-QEMU = "qemu-system-arm"
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.join(SOURCE_DIR, "bench", "firmware"))
+from qemu_mps2 import QEMU, monitor_command, qemu_command  # noqa: E402
 SKIP_STATUS = 77
 STACK_PAINT = 0x5AC3A55C  # kStackPaint of firmware/mps2_an386/startup.cpp
 TICK_US = 50
@@ -77,9 +79,8 @@ class Board:
                       f"out={self.windows_path}" + (f",profile={self.profile_path}" if profile else ""))
         self.log = open(os.path.join(directory, "qemu.log"), "wb")
         self.process = subprocess.Popen(
-            [QEMU, "-M", "mps2-an386", "-display", "none", "-nodefaults", "-icount", "shift=0,sleep=off",
-             "-plugin", plugin_arg, "-monitor", f"unix:{self.monitor_path},server=on,wait=off",
-             "-serial", f"unix:{serial_path},server=on,wait=off", "-kernel", image],
+            qemu_command(image, self.monitor_path, f"unix:{serial_path},server=on,wait=off",
+                         "-icount", "shift=0,sleep=off", "-plugin", plugin_arg),
             cwd=directory, stdin=subprocess.DEVNULL, stdout=self.log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + TIMEOUT_S
         while True:
@@ -145,17 +146,7 @@ class Board:
         raise RuntimeError("the plugin measured no window (is it loaded? qemu -plugin)")
 
     def monitor(self, command):
-        with socket.socket(socket.AF_UNIX) as sock:
-            sock.settimeout(30.0)
-            sock.connect(self.monitor_path)
-            output = b""
-            while not output.endswith(b"(qemu) "):
-                output += sock.recv(4096)
-            sock.sendall(command.encode() + b"\n")
-            output = b""
-            while not output.endswith(b"(qemu) "):
-                output += sock.recv(4096)
-            return output.decode(errors="replace")
+        return monitor_command(self.monitor_path, command)
 
 
 def symbols(image):

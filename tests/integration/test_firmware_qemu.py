@@ -32,13 +32,14 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from motwin_harness import (  # noqa: E402
-    BANK_GLOBAL, BANK_USER, GAP, GET_VERSION, MVP, MVP_ABS, SAP, STATUS_OK, STATUS_WRONG_TYPE, VERSION_BINARY, VERSION_STRING,
+    BANK_GLOBAL, BANK_USER, GAP, GET_VERSION, MVP, MVP_ABS, STATUS_OK, STATUS_WRONG_TYPE, VERSION_BINARY, VERSION_STRING,
     Skipped, TcpClient, TempDir, TestFailure, _die_with_parent, check, check_equal, expect_reply, run_tests,
 )
 
 SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FIRMWARE_DIR = os.environ.get("MOTWIN_FIRMWARE_DIR", os.path.join(SOURCE_DIR, "build-cortex-m"))
-QEMU = "qemu-system-arm"
+sys.path.insert(0, os.path.join(SOURCE_DIR, "bench", "firmware"))
+from qemu_mps2 import QEMU, monitor_command, qemu_command  # noqa: E402  (shared with bench/firmware_figures.py)
 BOOT_TIMEOUT = 60.0
 ENTER_ASCII = 139
 MOVE_TIMEOUT = 180.0  # 20000 counts at the default ramp take about 1 s of the board's time
@@ -72,9 +73,7 @@ class EmulatedBoard:
             self.port = free_port()
             with open(self.log_path, "wb") as log:
                 self.process = subprocess.Popen(
-                    [QEMU, "-M", "mps2-an386", "-display", "none", "-nodefaults",
-                     "-monitor", f"unix:{self.monitor_path},server=on,wait=off",
-                     "-serial", f"tcp:127.0.0.1:{self.port},server=on,wait=off", "-kernel", image],
+                    qemu_command(image, self.monitor_path, f"tcp:127.0.0.1:{self.port},server=on,wait=off"),
                     stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT, preexec_fn=_die_with_parent)
             deadline = time.monotonic() + BOOT_TIMEOUT
             while time.monotonic() < deadline and self.process.poll() is None:
@@ -99,18 +98,7 @@ class EmulatedBoard:
         self.process.wait()
 
     def monitor(self, command):
-        """One command on qemu's human monitor; returns what it printed up to the next prompt."""
-        with socket.socket(socket.AF_UNIX) as sock:
-            sock.settimeout(30.0)
-            sock.connect(self.monitor_path)
-            output = b""
-            while not output.endswith(b"(qemu) "):
-                output += sock.recv(4096)
-            sock.sendall(command.encode() + b"\n")
-            output = b""
-            while not output.endswith(b"(qemu) "):
-                output += sock.recv(4096)
-            return output.decode(errors="replace")
+        return monitor_command(self.monitor_path, command)
 
 
 def wait_until_answering(client):
