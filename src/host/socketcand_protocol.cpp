@@ -12,6 +12,8 @@ bool parse_hex(std::string_view text, uint32_t& value) {
   return result.ec == std::errc{} && result.ptr == text.data() + text.size();
 }
 
+bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
 }  // namespace
 
 void SocketcandElementParser::push(std::string_view bytes, std::vector<std::string>& out) {
@@ -52,16 +54,19 @@ void SocketcandElementParser::push(std::string_view bytes, std::vector<std::stri
 }
 
 std::vector<std::string_view> socketcand_words(std::string_view element) {
+  // Counted first: one allocation per element instead of one per doubling (a `send` of 8 bytes
+  // has 11 words).
+  size_t count = 0;
+  for (size_t i = 0; i < element.size(); ++i) {
+    if (!is_blank(element[i]) && (i == 0 || is_blank(element[i - 1]))) ++count;
+  }
   std::vector<std::string_view> words;
+  words.reserve(count);
   size_t i = 0;
   while (i < element.size()) {
-    while (i < element.size() && (element[i] == ' ' || element[i] == '\t' || element[i] == '\r' || element[i] == '\n')) {
-      ++i;
-    }
+    while (i < element.size() && is_blank(element[i])) ++i;
     const size_t start = i;
-    while (i < element.size() && element[i] != ' ' && element[i] != '\t' && element[i] != '\r' && element[i] != '\n') {
-      ++i;
-    }
+    while (i < element.size() && !is_blank(element[i])) ++i;
     if (i > start) words.push_back(element.substr(start, i - start));
   }
   return words;

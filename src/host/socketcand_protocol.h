@@ -22,6 +22,8 @@ class SocketcandElementParser {
  public:
   static constexpr size_t kMaxElementLength = 256;
 
+  SocketcandElementParser() { element_.reserve(kMaxElementLength); }  // never grows afterwards
+
   // Appends each complete element's inner text (between `<` and `>`) to `out`.
   void push(std::string_view bytes, std::vector<std::string>& out);
   size_t dropped_elements() const { return dropped_; }
