@@ -584,6 +584,10 @@ def sdo_seeds():
 
 # 2026-11-27: the eight_point_ramp campaign's findings (fuzz/README.md "Findings").
 EIGHT_POINT_RAMP_FINDINGS = [
+    # A profile changed to VMAX 0 while moving: the last braking tick rounded past 0 into a
+    # reversal (EightPointRamp.braking_to_rest_never_rounds_past_zero_into_a_reversal).
+    ("finding_2026_11_27_braking_rounds_past_zero",
+     "I///O8kA/////////3nmDsN/kiRCQgAAQkK8AAAF/QAF/QABAAAAAAAAAAX9BQAAAAX9Bg=="),
     ("finding_2026_11_27_last_q32_unit_of_a_crawl",
      "Nvox8M76hBMhY7OWzGjwyknJHtTMWmy1KwD+asWKbC2pkuwXyqCPIWOz/////////////xUpclJdysp4AAC4pTjH4KN5c5VYBwAA"
      "AQAAYwH5N4d0zj1nOs+8s0cdv0ncCw=="),

@@ -820,5 +820,53 @@ TEST(EightPointRamp, a_long_tick_that_brakes_to_vstop_early_ends_on_the_target) 
   EXPECT_LT(ticks, 10000);  // arrived in one go: no overshoot, TZEROWAIT and move back
 }
 
+// Fuzz finding (2026-11-27): a profile changed to VMAX 0 while moving at -400 pps brakes at DMAX
+// (100000 pps², 100 pps per 1 ms tick); the last tick's 100 - 100000 * 0.001 rounded to
+// -3.6e-15, and the axis turned to +3.6e-15 pps: a reversal without rest. Every band step now
+// ends on its bound at the latest.
+TEST(EightPointRamp, braking_to_rest_never_rounds_past_zero_into_a_reversal) {
+  EightPointConfig c;  // the finding's profile
+  c.vstart_pps = 25.882352941176475;
+  c.a1_pps2 = 2588.9764705882353;
+  c.v1_pps = 25.837057789014956;
+  c.a2_pps2 = 303089162.27157789;
+  c.v2_pps = 45.116824258591492;
+  c.vmax_pps = 0;
+  c.amax_pps2 = 100000;
+  c.dmax_pps2 = 100000;
+  c.d2_pps2 = 100000;
+  c.d1_pps2 = 100000;
+  c.vstop_pps = 44613.65922469693;
+  c.tzerowait_us = 0;
+  ASSERT_EQ(EightPointRamp::validate(c), EightPointConfigError::kNone);
+  EightPointRamp ramp;
+  ramp.set_state(0, -400.0);
+  ramp.set_position_target(-1145196883);
+  for (int tick = 1; tick <= 4; ++tick) {
+    ramp.step(c, 0.001);
+    EXPECT_LE(ramp.velocity(), 0.0) << "tick " << tick;
+  }
+  EXPECT_EQ(ramp.velocity(), 0.0);
+  ramp.step(c, 0.001);
+  EXPECT_EQ(ramp.velocity(), 0.0) << "VMAX 0: stays at rest";
+  // The same in velocity mode and in a stop: the last step lands on the goal, not past it.
+  EightPointRamp pv;
+  pv.set_state(0, -400.0);
+  pv.set_velocity_target(0.0);
+  for (int tick = 1; tick <= 5; ++tick) {
+    pv.step(c, 0.001);
+    EXPECT_LE(pv.velocity(), 0.0) << "pv tick " << tick;
+  }
+  EXPECT_EQ(pv.velocity(), 0.0);
+  EightPointRamp stop;
+  stop.set_state(0, -400.0);
+  stop.stop(100000);
+  for (int tick = 1; tick <= 5; ++tick) {
+    stop.step(c, 0.001);
+    EXPECT_LE(stop.velocity(), 0.0) << "stop tick " << tick;
+  }
+  EXPECT_EQ(stop.velocity(), 0.0);
+}
+
 }  // namespace
 }  // namespace motwin::motion
