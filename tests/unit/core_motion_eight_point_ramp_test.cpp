@@ -839,33 +839,27 @@ TEST(EightPointRamp, braking_to_rest_never_rounds_past_zero_into_a_reversal) {
   c.vstop_pps = 44613.65922469693;
   c.tzerowait_us = 0;
   ASSERT_EQ(EightPointRamp::validate(c), EightPointConfigError::kNone);
-  EightPointRamp ramp;
-  ramp.set_state(0, -400.0);
-  ramp.set_position_target(-1145196883);
-  for (int tick = 1; tick <= 4; ++tick) {
-    ramp.step(c, 0.001);
-    EXPECT_LE(ramp.velocity(), 0.0) << "tick " << tick;
-  }
-  EXPECT_EQ(ramp.velocity(), 0.0);
-  ramp.step(c, 0.001);
-  EXPECT_EQ(ramp.velocity(), 0.0) << "VMAX 0: stays at rest";
+  // From -400 pps, 100 pps per tick: at rest after the 4th tick, never above 0 on the way.
+  auto brakes_to_rest = [&c](EightPointRamp& ramp, const char* what) {
+    for (int tick = 1; tick <= 5; ++tick) {
+      ramp.step(c, 0.001);
+      EXPECT_LE(ramp.velocity(), 0.0) << what << ", tick " << tick;
+    }
+    EXPECT_EQ(ramp.velocity(), 0.0) << what;
+  };
+  EightPointRamp position;  // VMAX 0: brakes at DMAX and stays at rest
+  position.set_state(0, -400.0);
+  position.set_position_target(-1145196883);
+  brakes_to_rest(position, "position mode");
   // The same in velocity mode and in a stop: the last step lands on the goal, not past it.
   EightPointRamp pv;
   pv.set_state(0, -400.0);
   pv.set_velocity_target(0.0);
-  for (int tick = 1; tick <= 5; ++tick) {
-    pv.step(c, 0.001);
-    EXPECT_LE(pv.velocity(), 0.0) << "pv tick " << tick;
-  }
-  EXPECT_EQ(pv.velocity(), 0.0);
+  brakes_to_rest(pv, "pv");
   EightPointRamp stop;
   stop.set_state(0, -400.0);
   stop.stop(100000);
-  for (int tick = 1; tick <= 5; ++tick) {
-    stop.step(c, 0.001);
-    EXPECT_LE(stop.velocity(), 0.0) << "stop tick " << tick;
-  }
-  EXPECT_EQ(stop.velocity(), 0.0);
+  brakes_to_rest(stop, "stop");
 }
 
 }  // namespace
