@@ -285,28 +285,9 @@ def test_scope(motwin):
         server.stop()
 
 
-class WebBusServer(wh.WebServer):
-    """`motwin serve --node tmcm-1636 --node tmcm-3216:node-id=1` on a virtual bus with the web
-    console: two modules in the page's picker."""
-
-    BANNER = r"motwin: node tmcm-1636-1 tmcm-1636 \(1636V1\d\d\) eeprom (.+)"
-    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
-
-    def __init__(self, motwin, state_dir):
-        super().__init__(motwin, state_dir, tcp=False, extra_args=[
-            "--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
-        at = self.args.index("--module")
-        del self.args[at:at + 2]  # --node instead
-
-    def _parse_line(self, text):
-        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
-            return False  # the second node's banner
-        return super()._parse_line(text)
-
-
 def test_scope_module_switch(motwin):
     """Choosing another module stops the scope and offers the new module's rows and rates."""
-    with bh.browser_and_server(Browser, WebBusServer, motwin) as (browser, server):
+    with bh.browser_and_server(Browser, wh.WebBusServer, motwin) as (browser, server):
         browser.open_console(server.url("/"))
         browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
         browser.show("scope")

@@ -38,22 +38,11 @@ class WorldServer(wh.WebServer):
         super().__init__(motwin, state_dir, module="tmcm-142")
 
 
-class WorldBusServer(wh.WebServer):
+class WorldBusServer(wh.WebBusServer):
     """`motwin serve --node tmcm-142 --node tmcm-3216:node-id=1`: members of a bus take no scenario."""
 
+    FIRST_NODE = "tmcm-142"
     BANNER = r"motwin: node tmcm-142-1 tmcm-142 \(142V1\.06\) eeprom (.+)"
-    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
-
-    def __init__(self, motwin, state_dir):
-        super().__init__(motwin, state_dir, tcp=False, extra_args=[
-            "--node", "tmcm-142", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
-        at = self.args.index("--module")
-        del self.args[at:at + 2]  # --node instead
-
-    def _parse_line(self, text):
-        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
-            return False  # the second node's banner
-        return super()._parse_line(text)
 
 
 def require_websocket():
