@@ -15,7 +15,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import motwin_harness as mh  # noqa: E402
-from motwin_harness import TcpClient, TempDir, check, check_equal, run_tests  # noqa: E402
+from motwin_harness import TcpClient, check, check_equal, run_tests  # noqa: E402
 import browser_harness as bh  # noqa: E402
 import web_harness as wh  # noqa: E402
 
@@ -23,11 +23,10 @@ try:  # without Selenium, bh.HeadlessChromium skips the tests before any of thes
     from selenium.webdriver.common.action_chains import ActionChains
     from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from selenium.webdriver.support.ui import Select, WebDriverWait
+    from selenium.webdriver.support.ui import Select
 except ImportError:  # pragma: no cover - reported as a skip
     pass
 
-WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 MAX_CURRENT = 11  # TMCM-1636 axis parameter: 0..60000 mA
 # TMCM-1636 axis parameters the scope plots: target and actual position, actual velocity and
 # torque current; their CSV names.
@@ -35,20 +34,8 @@ SCOPE_CURVES = {"a50": "AP50", "a52": "AP52", "a42": "AP42", "a31": "AP31"}
 SCOPE_TARGET = 40000  # counts: with the default ramp (AP 45 = 1) a motion of about 0.7 s simulated
 
 
-class Browser(bh.HeadlessChromium):
+class Browser(bh.ConsolePage):
     """The console's page in headless Chromium, with helpers for its views."""
-
-    def wait(self, description, condition):
-        try:
-            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
-        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
-            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
-
-    def find(self, css):
-        return self.driver.find_element(By.CSS_SELECTOR, css)
-
-    def finds(self, css):
-        return self.driver.find_elements(By.CSS_SELECTOR, css)
 
     def value_of(self, key):
         elements = self.finds(f'input[data-key="{key}"]')
@@ -66,18 +53,6 @@ class Browser(bh.HeadlessChromium):
         if text:
             field.send_keys(text)
 
-    def show(self, view):
-        self.find(f'#tabs [data-view="{view}"]').click()
-        self.wait(f"the {view} view", lambda: self.find(f"#view-{view}").is_displayed())
-
-    def screenshot(self, motwin, name):
-        path = os.path.join(bh.artefact_dir(motwin, "web-browser"), name + ".png")
-        check(self.driver.save_screenshot(path), f"screenshot {path}")
-
-    def check_log_clean(self):
-        severe = self.severe_log_entries()
-        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
-
     def console_lines(self):
         return [item.text for item in self.finds("#console-log li")]
 
@@ -88,10 +63,9 @@ class Browser(bh.HeadlessChromium):
 
 
 def test_parameters_and_console(motwin):
-    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, wh.WebServer, motwin) as (browser, server), \
             TcpClient(server.tcp_port) as tmcl:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(server.url("/"))
         key = f"a{MAX_CURRENT}"
         # A live value: what the module holds, then what a TMCL host changes it to.
         before = tmcl.gap(MAX_CURRENT)
@@ -183,10 +157,9 @@ def test_scope(motwin):
     over TMCL/TCP; pause and cursor readout; CSV and PNG export; the Parameters view stays live
     meanwhile; leaving the tab stops the scope's subscription; a restart with a level trigger
     captures a motion back."""
-    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, wh.WebServer, motwin) as (browser, server), \
             TcpClient(server.tcp_port) as tmcl:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(server.url("/"))
         browser.show("scope")
         # The rates are offered once the module list has arrived, which may follow "connected".
         browser.wait("the scope's rates", lambda: browser.finds("#scope-rate option:checked") != [])
@@ -312,30 +285,10 @@ def test_scope(motwin):
         server.stop()
 
 
-class WebBusServer(wh.WebServer):
-    """`motwin serve --node tmcm-1636 --node tmcm-3216:node-id=1` on a virtual bus with the web
-    console: two modules in the page's picker."""
-
-    BANNER = r"motwin: node tmcm-1636-1 tmcm-1636 \(1636V1\d\d\) eeprom (.+)"
-    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
-
-    def __init__(self, motwin, state_dir):
-        super().__init__(motwin, state_dir, tcp=False, extra_args=[
-            "--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
-        at = self.args.index("--module")
-        del self.args[at:at + 2]  # --node instead
-
-    def _parse_line(self, text):
-        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
-            return False  # the second node's banner
-        return super()._parse_line(text)
-
-
 def test_scope_module_switch(motwin):
     """Choosing another module stops the scope and offers the new module's rows and rates."""
-    with Browser() as browser, TempDir() as state, WebBusServer(motwin, state).start() as server:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+    with bh.browser_and_server(Browser, wh.WebBusServer, motwin) as (browser, server):
+        browser.open_console(server.url("/"))
         browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
         browser.show("scope")
         # The TMCM-1636 speaks TMCL on the bus only: the console reaches it by TMCL over CAN.
@@ -361,9 +314,8 @@ def test_scope_module_switch(motwin):
 
 
 def test_canopen_node(motwin):
-    with Browser() as browser, TempDir() as state, wh.WebCanServer(motwin, state).start() as server:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+    with bh.browser_and_server(Browser, wh.WebCanServer, motwin) as (browser, server):
+        browser.open_console(server.url("/"))
         browser.wait("the node's objects", lambda: browser.finds('tr[data-key="o1000.0"]') != [])
         browser.wait("a live value of 1000 sub 0", lambda: (browser.value_of("o1000.0") or "") != "")
         # Edit an object: 6060 modes of operation.
@@ -415,14 +367,13 @@ def canopen_axis_cell(browser, axis, name):
 def test_canopen_view(motwin):
     """The CANopen view of a TMCM-3216: the NMT state as the console hears it, NMT start from the
     view, the statusword decoded as controlwords go over SDO, the PDO mappings, the errors."""
-    with Browser() as browser, TempDir() as state, wh.WebCanServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, wh.WebCanServer, motwin) as (browser, server), \
             server.console() as console:
         # A heartbeat, so that the console hears every state the node is in.
         check(console.ask("sdo_write", module=0, index=0x1017, sub=0, value=20)["ok"], "1017 = 20 ms")
         listing = console.ask("list")["modules"][0]
         defaults = {(o["index"], o["sub"]): o for section in listing["sections"] for o in section["objects"]}
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(server.url("/"))
         browser.wait("the node's objects", lambda: browser.finds('tr[data-key="o1000.0"]') != [])
         browser.show("canopen")
         nmt_state = lambda: browser.find("#canopen-nmt-state").text  # noqa: E731

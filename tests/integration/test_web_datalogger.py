@@ -22,13 +22,12 @@ import web_harness as wh  # noqa: E402
 
 try:  # without Selenium, bh.HeadlessChromium skips the tests before any of these is used
     from selenium.webdriver.common.by import By
-    from selenium.webdriver.support.ui import Select, WebDriverWait
+    from selenium.webdriver.support.ui import Select
 except ImportError:  # pragma: no cover - reported as a skip
     pass
 
 RAMDEBUG, GET_STATE, GET_SAMPLE = 142, 8, 9
 STATUS_OK = 100
-WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 ACTUAL_VELOCITY, ACTUAL_POSITION, TORQUE_CURRENT = 42, 52, 31  # TMCM-1636 axis parameters
 STEP_RPM = 2000
 TRIGGER_RPM = 50
@@ -100,30 +99,11 @@ def test_datalogger_over_websocket(motwin):
         server.stop()
 
 
-class Browser(bh.HeadlessChromium):
-    def wait(self, description, condition):
-        try:
-            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
-        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
-            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
-
-    def find(self, css):
-        return self.driver.find_element(By.CSS_SELECTOR, css)
-
-    def show(self, view):
-        self.find(f'#tabs [data-view="{view}"]').click()
-        self.wait(f"the {view} view", lambda: self.find(f"#view-{view}").is_displayed())
+class Browser(bh.ConsolePage):
+    ARTEFACTS = "web-datalogger"
 
     def datalogger(self, expression):
         return self.js("const d = window.motwinDatalogger; return " + expression + ";")
-
-    def screenshot(self, motwin, name):
-        path = os.path.join(bh.artefact_dir(motwin, "web-datalogger"), name + ".png")
-        check(self.driver.save_screenshot(path), f"screenshot {path}")
-
-    def check_log_clean(self):
-        severe = self.severe_log_entries()
-        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
 
 
 def set_number(browser, css, value):
@@ -135,10 +115,9 @@ def test_datalogger_in_browser(motwin):
     """A TMCM-1636 velocity step captured at 2 kHz from the Scope view: the plotted sample count
     and 0.5 ms spacing, the trigger at 0 s, the curve moving, CSV and PNG export; repeat captures
     again; a TMCM-142 offers no datalogger mode; no SEVERE browser log entry."""
-    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, wh.WebServer, motwin) as (browser, server), \
             TcpClient(server.tcp_port) as tmcl:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(server.url("/"))
         browser.show("scope")
         browser.wait("the datalogger mode to be offered", lambda: browser.find("#scope-mode").is_displayed())
         check("2000 Hz" in browser.find("#datalogger-mode-label").text, "the mode names the base rate")
@@ -225,9 +204,8 @@ def test_datalogger_in_browser(motwin):
         browser.check_log_clean()
         server.stop()
 
-    with Browser() as browser, TempDir() as state, Tmcm142WebServer(motwin, state).start() as server:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+    with bh.browser_and_server(Browser, Tmcm142WebServer, motwin) as (browser, server):
+        browser.open_console(server.url("/"))
         browser.show("scope")
         browser.wait("the live scope's curves", lambda: browser.js("return document.querySelectorAll('#scope-choices li').length") > 0)
         # The page asked GET_INFO and the TMCM-142 answered status 2: wait for that answer.

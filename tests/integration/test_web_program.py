@@ -24,11 +24,9 @@ import web_harness as wh  # noqa: E402
 
 try:  # without Selenium, bh.HeadlessChromium skips the test before any of these is used
     from selenium.webdriver.common.by import By
-    from selenium.webdriver.support.ui import WebDriverWait
 except ImportError:  # pragma: no cover - reported as a skip
     pass
 
-WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 APPLICATION_STATUS = 135
 GLOBAL_BANK_USER = 2
 # Counts in the accumulator and copies it to user variable 0 (GGP 0, 2).
@@ -61,12 +59,12 @@ def tcp_status(tmcl):
 
 
 def wait_for(description, condition):
-    deadline = time.monotonic() + WAIT_S
+    deadline = time.monotonic() + bh.WAIT_S
     while True:
         value = condition()
         if value:
             return value
-        check(time.monotonic() < deadline, f"waited {WAIT_S} s for {description}")
+        check(time.monotonic() < deadline, f"waited {bh.WAIT_S} s for {description}")
         time.sleep(0.01)
 
 
@@ -217,18 +215,8 @@ def sync_can_host(console, bus, send_id=2):
                 struct.unpack_from(">i", bytes(m.data), 3)[0] == mark, mh.FRAME_TIMEOUT, f"the reply to SGP 50, 2, {mark}")
 
 
-class Browser(bh.HeadlessChromium):
-    def wait(self, description, condition):
-        try:
-            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
-        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
-            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
-
-    def find(self, css):
-        return self.driver.find_element(By.CSS_SELECTOR, css)
-
-    def finds(self, css):
-        return self.driver.find_elements(By.CSS_SELECTOR, css)
+class Browser(bh.ConsolePage):
+    ARTEFACTS = "web-program"
 
     def text(self, element_id):
         return self.driver.find_element(By.ID, element_id).text
@@ -243,21 +231,15 @@ class Browser(bh.HeadlessChromium):
     def replies_seen(self):
         return self.js("return window.motwinProgram.statusReplies")
 
-    def screenshot(self, motwin, name):
-        path = os.path.join(bh.artefact_dir(motwin, "web-program"), name + ".png")
-        check(self.driver.save_screenshot(path), f"screenshot {path}")
-
 
 MODE_NAMES = {0: "stop", 1: "run", 2: "step", 3: "reset"}
 
 
 def test_program_view(motwin):
-    with Browser() as browser, TempDir() as state, wh.WebServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, wh.WebServer, motwin) as (browser, server), \
             TcpClient(server.tcp_port) as tmcl:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
-        browser.find('#tabs [data-view="program"]').click()
-        browser.wait("the program view", lambda: browser.find("#view-program").is_displayed())
+        browser.open_console(server.url("/"))
+        browser.show("program")
         # Factory memory: STOP everywhere, read to its end.
         browser.wait("the stored program", lambda: len(browser.finds("#program-lines tbody tr")) == 2048)
         browser.wait("a live status", lambda: browser.status_shown() is not None)
@@ -346,8 +328,7 @@ def test_program_view(motwin):
         seen = browser.replies_seen()
         tmcl.wait_sim_ms(300)
         check(browser.replies_seen() <= seen + 1, "status replies after leaving the view")
-        severe = browser.severe_log_entries()
-        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+        browser.check_log_clean()
         server.stop()
 
 
@@ -357,10 +338,9 @@ def test_program_view_over_can(motwin):
     same console port: a second TMCL-over-CAN host would confuse the module's replies)."""
     args = ["--node", "tmcm-1636", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0",
             "--web", "127.0.0.1:0"]
-    with Browser() as browser, TempDir() as state, cbh.BusServer(motwin, state, args).start() as server, \
+    with bh.browser_and_server(Browser, cbh.BusServer, motwin, args) as (browser, server), \
             wh.ConsoleClient(server.port("web")) as console:
-        browser.driver.get(f"http://127.0.0.1:{server.port('web')}/")
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(f"http://127.0.0.1:{server.port('web')}/")
         browser.wait("two modules", lambda: len(browser.finds("#module-picker option")) == 2)
         browser.find('#tabs [data-view="program"]').click()
         browser.wait("the program view", lambda: browser.find("#program-body").is_displayed())
@@ -383,8 +363,7 @@ def test_program_view_over_can(motwin):
                    "p.dispatchEvent(new Event('change'));")
         browser.wait("the line for a module without TMCL", lambda: browser.find("#program-none").is_displayed())
         check(not browser.find("#program-body").is_displayed(), "no program body for a CANopen node")
-        severe = browser.severe_log_entries()
-        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+        browser.check_log_clean()
         server.stop()
 
 

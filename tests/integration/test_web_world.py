@@ -19,13 +19,10 @@ import browser_harness as bh  # noqa: E402
 import web_harness as wh  # noqa: E402
 
 try:  # without Selenium, bh.HeadlessChromium skips the browser test before any of these is used
-    from selenium.webdriver.common.by import By
     from selenium.webdriver.common.keys import Keys
-    from selenium.webdriver.support.ui import WebDriverWait
 except ImportError:  # pragma: no cover - reported as a skip
     pass
 
-WAIT_S = 60.0  # an upper bound for a condition on a loaded machine, never a pause
 LEFT_ENDSTOP = 11    # TMCM-142 AP 11: 1 while the left limit switch is closed
 SWITCH_STATUS = 9    # AP 9: bit 0 right, bit 1 left, bit 2 home
 DRIVER_STATUS = 26   # AP 26: bit 1 supply below 15 V
@@ -41,22 +38,11 @@ class WorldServer(wh.WebServer):
         super().__init__(motwin, state_dir, module="tmcm-142")
 
 
-class WorldBusServer(wh.WebServer):
+class WorldBusServer(wh.WebBusServer):
     """`motwin serve --node tmcm-142 --node tmcm-3216:node-id=1`: members of a bus take no scenario."""
 
+    FIRST_NODE = "tmcm-142"
     BANNER = r"motwin: node tmcm-142-1 tmcm-142 \(142V1\.06\) eeprom (.+)"
-    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
-
-    def __init__(self, motwin, state_dir):
-        super().__init__(motwin, state_dir, tcp=False, extra_args=[
-            "--node", "tmcm-142", "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
-        at = self.args.index("--module")
-        del self.args[at:at + 2]  # --node instead
-
-    def _parse_line(self, text):
-        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
-            return False  # the second node's banner
-        return super()._parse_line(text)
 
 
 def require_websocket():
@@ -132,23 +118,7 @@ def test_world_of_a_bus_is_read_only(motwin):
         server.stop()
 
 
-class Browser(bh.HeadlessChromium):
-    def wait(self, description, condition):
-        try:
-            return WebDriverWait(self.driver, WAIT_S, poll_frequency=0.02).until(lambda d: condition())
-        except Exception as error:  # noqa: BLE001 - the condition's own failure is the message
-            raise mh.TestFailure(f"waited {WAIT_S} s for {description}: {type(error).__name__}") from None
-
-    def find(self, css):
-        return self.driver.find_element(By.CSS_SELECTOR, css)
-
-    def finds(self, css):
-        return self.driver.find_elements(By.CSS_SELECTOR, css)
-
-    def screenshot(self, motwin, name):
-        path = os.path.join(bh.artefact_dir(motwin, "web-browser"), name + ".png")
-        check(self.driver.save_screenshot(path), f"screenshot {path}")
-
+class Browser(bh.ConsolePage):
     # The drawing is made afresh with every poll: read it by script, not by held elements.
     def drawn_angle(self):
         value = self.js('const d = document.querySelector("#world-axis-0 svg"); return d && d.dataset.angleDeg;')
@@ -165,10 +135,9 @@ class Browser(bh.HeadlessChromium):
 
 
 def test_world_view(motwin):
-    with Browser() as browser, TempDir() as state, WorldServer(motwin, state).start() as server, \
+    with bh.browser_and_server(Browser, WorldServer, motwin) as (browser, server), \
             TcpClient(server.tcp_port) as tmcl:
-        browser.driver.get(server.url("/"))
-        browser.wait("the page to connect", lambda: browser.find("body").get_attribute("data-state") == "connected")
+        browser.open_console(server.url("/"))
         browser.find('#tabs [data-view="world"]').click()
         browser.wait("the World view's controls", lambda: browser.finds('input[type="checkbox"][data-signal="REF_L"]'))
         browser.wait("the shaft drawn", lambda: browser.drawn_angle() == 0.0)
@@ -203,8 +172,7 @@ def test_world_view(motwin):
         # Leaving the view ends its session: its polls stop while the page stays connected.
         browser.find('#tabs [data-view="parameters"]').click()
         browser.wait("the World view's session to close", lambda: not browser.js("return window.MotwinWorld.running"))
-        severe = browser.severe_log_entries()
-        check(not severe, f"SEVERE entries in the browser's log: {severe!r}")
+        browser.check_log_clean()
         server.stop()
 
 

@@ -48,6 +48,27 @@ class WebCanServer(CanServer):
         return ConsoleClient(self.web_port)
 
 
+class WebBusServer(WebServer):
+    """`motwin serve --node FIRST_NODE --node tmcm-3216:node-id=1` on a virtual bus (socketcand on a
+    free port) with the web console: two modules in the page's picker. BANNER is the first node's;
+    the TMCM-3216's (node tmcm-3216-2) is passed over."""
+
+    FIRST_NODE = "tmcm-1636"
+    BANNER = r"motwin: node tmcm-1636-1 tmcm-1636 \(1636V1\d\d\) eeprom (.+)"
+    PORT_ENDPOINTS = {"can-socketcand": "can_port", "web": "web_port"}
+
+    def __init__(self, motwin, state_dir):
+        super().__init__(motwin, state_dir, tcp=False, extra_args=[
+            "--node", self.FIRST_NODE, "--node", "tmcm-3216:node-id=1", "--can", "socketcand:127.0.0.1:0"])
+        at = self.args.index("--module")
+        del self.args[at:at + 2]  # --node instead
+
+    def _parse_line(self, text):
+        if self.banner is not None and text.startswith("motwin: node tmcm-3216-2 tmcm-3216 "):
+            return False  # the second node's banner
+        return super()._parse_line(text)
+
+
 def http_get(url):
     """(status, content type, body) of a GET; an HTTP error status is returned, not raised."""
     try:

@@ -13,127 +13,49 @@
 
 #include <nlohmann/json.hpp>
 
-#include "host/can_bus.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
+#include "support/web_console_rig.h"
 #include "tools/web/web_console.h"
 
 namespace motwin::tools::web {
 namespace {
 
 using Json = nlohmann::json;
+using motwin::testing::FakeWebConnection;
 
-class FakeConnection final : public host::web::WebConnection {
+// A console on one module, and a session talking to it. Requests are bounded in wall time: an
+// SDO transfer to a silent node ends after WebConsole::kSdoTimeoutUs.
+class ConsoleRig : public motwin::testing::WebConsoleRig {
  public:
-  void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override {
-    latest = Json::parse(message);
-    ++latest_count;
-  }
-  size_t queued_bytes() const override { return queued; }
+  explicit ConsoleRig(const char* module_name)
+      : WebConsoleRig(module_name,
+                      motwin::testing::WebConsoleRigSetup().with_reply_wait(motwin::testing::ReplyWait::kWallClock)) {}
 
-  size_t queued = 0;  // what the fake pretends a page left unread
-  std::vector<Json> replies;
-  std::optional<Json> latest;
-  size_t latest_count = 0;  // pushes handed to send_latest
-};
-
-std::unique_ptr<host::VirtualModule> make(const char* name) {
-  host::ModuleOptions options;
-  options.log = [](const std::string&) {};
-  host::MakeModuleResult made = host::make_module(name, options);
-  EXPECT_TRUE(made) << made.error();
-  return std::move(*made);
-}
-
-// A console on one module, and a session talking to it.
-class ConsoleRig {
- public:
-  explicit ConsoleRig(const char* module_name) : module_(make(module_name)) {
-    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
-    const host::ModuleDescriptor& descriptor = *host::find_module(module_name);
-    std::vector<ConsoleTarget> targets;
-    if (module_->has_tmcl()) {
-      targets.push_back(tmcl_target(descriptor, std::string(module_->name()), std::string(module_->firmware_version()),
-                                    "", &runtime_->service()));
-    } else {
-      bus_ = std::make_unique<host::CanBus>([this] { return module_->sim_time_us(); });
-      module_->can_node()->connect(*bus_);
-      targets.push_back(canopen_target(descriptor, std::string(module_->name()),
-                                       std::string(module_->firmware_version()), 1));
-    }
-    console_ = std::make_unique<WebConsole>(
-        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), bus_.get());
-    session_ = console_->open_session(connection_);
-    runtime_->start();
-  }
-  ~ConsoleRig() {
-    session_.reset();
-    console_.reset();
-    if (bus_) module_->can_node()->disconnect();
-  }
-
-  // Sends `text` and runs the module until the reply with `id` arrives.
-  Json ask_text(const std::string& text, const Json& id) {
-    const size_t before = connection_.replies.size();
-    session_->on_message(text);
-    // Bounded in wall time: an SDO transfer to a silent node ends after WebConsole::kSdoTimeoutUs.
-    const uint64_t give_up_us = host::monotonic_now_us() + 10'000'000;
-    while (host::monotonic_now_us() < give_up_us) {
-      for (size_t i = before; i < connection_.replies.size(); ++i) {
-        if (connection_.replies[i]["id"] == id) return connection_.replies[i];
-      }
-      runtime_->step(1000);
-    }
-    ADD_FAILURE() << "no reply to " << text;
-    return Json{};
-  }
-  Json ask(Json request) {
-    static int next_id = 1;
-    request["id"] = next_id++;
-    return ask_text(request.dump(), request["id"]);
-  }
-  void send_only(const std::string& text) { session_->on_message(text); }
   void run_until_replies(size_t count) {
-    for (int step = 0; step < 1000000 && connection_.replies.size() < count; ++step) runtime_->step(0);
+    for (int step = 0; step < 1000000 && connection().replies.size() < count; ++step) runtime().step(0);
   }
-  // Runs simulated time forward.
-  void run_for_us(uint64_t sim_us) { runtime_->advance_ticks(sim_us / module_->tick_period_us()); }
   // Runs until a push arrives in the latest slot; returns it.
   Json next_push() {
-    connection_.latest.reset();
-    for (int step = 0; step < 2000000 && !connection_.latest; ++step) runtime_->step(0);
-    EXPECT_TRUE(connection_.latest.has_value());
-    return connection_.latest.value_or(Json{});
+    connection().latest.reset();
+    for (int step = 0; step < 2000000 && !connection().latest; ++step) runtime().step(0);
+    EXPECT_TRUE(connection().latest.has_value());
+    return connection().latest.value_or(Json{});
   }
   // Runs until a "frames" push arrives after reply `from`; returns it (null: none came within
   // `wait_us` of wall time; pushes are due every WebConsole::kMonitorPeriodUs).
   Json next_frames_push(size_t from, uint64_t wait_us = 5'000'000) {
     const uint64_t give_up_us = host::monotonic_now_us() + wait_us;
     while (host::monotonic_now_us() < give_up_us) {
-      for (size_t i = from; i < connection_.replies.size(); ++i) {
-        if (connection_.replies[i].value("push", "") == "frames") return connection_.replies[i];
+      for (size_t i = from; i < connection().replies.size(); ++i) {
+        if (connection().replies[i].value("push", "") == "frames") return connection().replies[i];
       }
-      runtime_->step(1000);
+      runtime().step(1000);
     }
     return Json{};
   }
-  host::VirtualModule& module() { return *module_; }
-  FakeConnection& connection() { return connection_; }
-  // Another page's session on the same console.
-  std::unique_ptr<host::web::WebSessionHandler> open_session(FakeConnection& connection) {
-    return console_->open_session(connection);
-  }
-  void step() { runtime_->step(0); }
-  uint64_t served_tmcl_requests() { return runtime_->service().served_request_count(); }
-
- private:
-  std::unique_ptr<host::VirtualModule> module_;
-  std::unique_ptr<host::HostRuntime> runtime_;
-  std::unique_ptr<host::CanBus> bus_;
-  std::unique_ptr<WebConsole> console_;
-  FakeConnection connection_;
-  std::unique_ptr<host::web::WebSessionHandler> session_;
+  void step() { runtime().step(0); }
+  uint64_t served_tmcl_requests() { return runtime().service().served_request_count(); }
 };
 
 // --- Messages the console cannot read ---------------------------------------------------------
@@ -285,14 +207,14 @@ TEST(WebConsole, subscription_pushes_batches_with_advancing_simulated_time) {
 // its own push, with the same simulated time and values.
 TEST(WebConsole, sessions_subscribed_to_the_same_rows_share_their_reads) {
   ConsoleRig rig("tmcm-1636");
-  FakeConnection other_connection;
+  FakeWebConnection other_connection;
   std::unique_ptr<host::web::WebSessionHandler> other = rig.open_session(other_connection);
   Json items = Json::array();
   for (int number : {0, 1, 2, 3, 4, 5, 6, 11}) items.push_back({{"kind", "axis"}, {"number", number}});
   const Json subscribe = {{"id", 7}, {"op", "subscribe"}, {"items", items}, {"rate_hz", 50}};
   rig.send_only(subscribe.dump());
   other->on_message(subscribe.dump());
-  FakeConnection& first = rig.connection();
+  FakeWebConnection& first = rig.connection();
   const auto run_until_both_have = [&](size_t pushes) {
     for (int step = 0; step < 2'000'000 && (first.latest_count < pushes || other_connection.latest_count < pushes);
          ++step) {
@@ -400,7 +322,7 @@ TEST(WebConsole, canopen_subscription_reads_objects) {
 // --- The bus monitor -----------------------------------------------------------------------------
 
 // The frames of pushes from reply `from` on, in order.
-std::vector<Json> pushed_frames(const FakeConnection& connection, size_t from) {
+std::vector<Json> pushed_frames(const FakeWebConnection& connection, size_t from) {
   std::vector<Json> frames;
   for (size_t i = from; i < connection.replies.size(); ++i) {
     if (connection.replies[i].value("push", "") != "frames") continue;

@@ -10,9 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "host/can_bus.h"
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
+#include "support/web_console_rig.h"
 #include "tools/web/web_console.h"
 #include "tools/web/web_datalogger.h"
 
@@ -20,64 +20,13 @@ namespace motwin::tools::web {
 namespace {
 
 using Json = nlohmann::json;
-
-class FakeConnection final : public host::web::WebConnection {
- public:
-  void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override { latest.push_back(Json::parse(message)); }
-  size_t queued_bytes() const override { return 0; }
-
-  std::vector<Json> replies;
-  std::vector<Json> latest;
-};
+using motwin::testing::FakeWebConnection;
 
 // A console on one module and two sessions (a page's capture and its live values).
-class Rig {
+class Rig : public motwin::testing::WebConsoleRig {
  public:
-  explicit Rig(const char* module_name) {
-    host::ModuleOptions options;
-    options.log = [](const std::string&) {};
-    host::MakeModuleResult made = host::make_module(module_name, options);
-    EXPECT_TRUE(made) << made.error();
-    module_ = std::move(*made);
-    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
-    const host::ModuleDescriptor& descriptor = *host::find_module(module_name);
-    std::vector<ConsoleTarget> targets;
-    if (module_->has_tmcl()) {
-      targets.push_back(tmcl_target(descriptor, std::string(module_->name()), std::string(module_->firmware_version()),
-                                    "", &runtime_->service()));
-    } else {
-      bus_ = std::make_unique<host::CanBus>([this] { return module_->sim_time_us(); });
-      module_->can_node()->connect(*bus_);
-      targets.push_back(
-          canopen_target(descriptor, std::string(module_->name()), std::string(module_->firmware_version()), 1));
-    }
-    console_ = std::make_unique<WebConsole>(
-        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), bus_.get());
-    session_ = console_->open_session(connection_);
-    other_session_ = console_->open_session(other_connection_);
-    runtime_->start();
-  }
-  ~Rig() {
-    session_.reset();
-    other_session_.reset();
-    console_.reset();
-    if (bus_) module_->can_node()->disconnect();
-  }
+  explicit Rig(const char* module_name) : WebConsoleRig(module_name), other_session_(open_session(other_connection_)) {}
 
-  Json ask(Json request) {
-    request["id"] = next_id_++;
-    const size_t before = connection_.replies.size();
-    session_->on_message(request.dump());
-    for (int step = 0; step < 2'000'000; ++step) {
-      for (size_t i = before; i < connection_.replies.size(); ++i) {
-        if (connection_.replies[i]["id"] == request["id"]) return connection_.replies[i];
-      }
-      runtime_->step(0);
-    }
-    ADD_FAILURE() << "no reply to " << request.dump();
-    return Json{};
-  }
   Json datalogger(Json request) {
     request["op"] = "datalogger";
     return ask(std::move(request));
@@ -88,35 +37,18 @@ class Rig {
     for (int poll = 0; poll < 2000; ++poll) {
       reply = datalogger({{"action", "state"}});
       if (reply.value("state", "") == state) return reply;
-      runtime_->advance_ticks(20);  // 1 ms of a TMCM-1636
+      runtime().advance_ticks(20);  // 1 ms of a TMCM-1636
     }
     ADD_FAILURE() << "the datalogger never reached " << state << ": " << reply.dump();
     return reply;
   }
-  // Sends without waiting for the reply.
-  void post(Json request) { session_->on_message(request.dump()); }
-  bool replied(const Json& id) const { return !reply_to(id).is_null(); }
-  Json reply_to(const Json& id) const {
-    for (const Json& reply : connection_.replies) {
-      if (reply["id"] == id) return reply;
-    }
-    return Json{};
-  }
-  FakeConnection& other_connection() { return other_connection_; }
+  bool replied(const Json& id) const { return !find_reply(id).is_null(); }
+  FakeWebConnection& other_connection() { return other_connection_; }
   host::web::WebSessionHandler& other_session() { return *other_session_; }
-  void close_session() { session_.reset(); }
-  host::HostRuntime& runtime() { return *runtime_; }
 
  private:
-  std::unique_ptr<host::VirtualModule> module_;
-  std::unique_ptr<host::HostRuntime> runtime_;
-  std::unique_ptr<host::CanBus> bus_;
-  std::unique_ptr<WebConsole> console_;
-  FakeConnection connection_;
-  FakeConnection other_connection_;
-  std::unique_ptr<host::web::WebSessionHandler> session_;
+  FakeWebConnection other_connection_;
   std::unique_ptr<host::web::WebSessionHandler> other_session_;
-  int next_id_ = 1;
 };
 
 TEST(WebDatalogger, info_gives_the_modules_figures) {
@@ -244,7 +176,7 @@ TEST(WebDatalogger, other_requests_take_turns_during_a_read_out) {
   const Json read = rig.datalogger({{"action", "read"}});  // a first, complete read
   ASSERT_EQ(read["samples"], 4096);
   // A second read, and while it runs another session's GAP: the GAP is answered first.
-  rig.post(Json{{"id", "read"}, {"op", "datalogger"}, {"action", "read"}});
+  rig.send_only(Json{{"id", "read"}, {"op", "datalogger"}, {"action", "read"}}.dump());
   for (int step = 0; step < 50; ++step) rig.runtime().step(0);
   ASSERT_FALSE(rig.replied("read"));
   rig.other_session().on_message(Json{{"id", "gap"}, {"op", "get"}, {"number", 52}}.dump());
@@ -253,7 +185,7 @@ TEST(WebDatalogger, other_requests_take_turns_during_a_read_out) {
   EXPECT_EQ(rig.other_connection().replies[0]["id"], "gap");
   EXPECT_FALSE(rig.replied("read"));  // 8192 GET_SAMPLEs are not done yet
   for (int step = 0; step < 2'000'000 && !rig.replied("read"); ++step) rig.runtime().step(0);
-  const Json again = rig.reply_to("read");
+  const Json again = rig.find_reply("read");
   ASSERT_EQ(again["ok"], true);
   EXPECT_EQ(again["values"], read["values"]);
 }
@@ -264,7 +196,7 @@ TEST(WebDatalogger, a_session_closed_during_a_read_out_ends_it) {
   Rig rig("tmcm-1636");
   ASSERT_EQ(rig.datalogger({{"action", "start"}, {"channels", {{{"number", 52}}}}, {"samples", 8192}})["ok"], true);
   rig.wait_for_state("complete");
-  rig.post(Json{{"id", "read"}, {"op", "datalogger"}, {"action", "read"}});
+  rig.send_only(Json{{"id", "read"}, {"op", "datalogger"}, {"action", "read"}}.dump());
   for (int step = 0; step < 50; ++step) rig.runtime().step(0);
   ASSERT_FALSE(rig.replied("read"));
   const uint64_t served_before = rig.runtime().service().served_request_count();

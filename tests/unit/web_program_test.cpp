@@ -13,73 +13,22 @@
 
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
+#include "support/web_console_rig.h"
 #include "tools/web/web_console.h"
 
 namespace motwin::tools::web {
 namespace {
 
 using Json = nlohmann::json;
+using motwin::testing::FakeWebConnection;
 
-class FakeConnection final : public host::web::WebConnection {
+class ProgramRig : public motwin::testing::WebConsoleRig {
  public:
-  void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override { latest = Json::parse(message); }
-  size_t queued_bytes() const override { return 0; }
+  using WebConsoleRig::WebConsoleRig;
 
-  std::vector<Json> replies;
-  Json latest;
-};
-
-class ProgramRig {
- public:
-  explicit ProgramRig(const char* module_name) {
-    host::ModuleOptions options;
-    options.log = [](const std::string&) {};
-    host::MakeModuleResult made = host::make_module(module_name, options);
-    EXPECT_TRUE(made) << made.error();
-    module_ = std::move(*made);
-    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
-    std::vector<ConsoleTarget> targets;
-    targets.push_back(tmcl_target(*host::find_module(module_name), std::string(module_->name()),
-                                  std::string(module_->firmware_version()), "", &runtime_->service()));
-    console_ = std::make_unique<WebConsole>(
-        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), nullptr);
-    session_ = console_->open_session(connection_);
-    runtime_->start();
-  }
-  ~ProgramRig() {
-    session_.reset();
-    console_.reset();
-  }
-
-  // Sends `request` without waiting; returns its id.
-  int send(Json request) {
-    request["id"] = next_id_;
-    session_->on_message(request.dump());
-    return next_id_++;
-  }
   // Runs the module until the reply with `id` has arrived.
-  Json reply_to(int id) {
-    for (int step = 0; step < 2'000'000; ++step) {
-      for (const Json& reply : connection_.replies) {
-        if (reply["id"] == id) return reply;
-      }
-      runtime_->step(0);
-    }
-    ADD_FAILURE() << "no reply to request " << id;
-    return Json{};
-  }
-  Json ask(Json request) { return reply_to(send(std::move(request))); }
-  void run_for_us(uint64_t sim_us) { runtime_->advance_ticks(sim_us / module_->tick_period_us()); }
+  Json reply_to(int id) { return wait_for_reply(id); }
   Json status() { return ask({{"op", "app_status"}}); }
-
- private:
-  std::unique_ptr<host::VirtualModule> module_;
-  std::unique_ptr<host::HostRuntime> runtime_;
-  std::unique_ptr<WebConsole> console_;
-  FakeConnection connection_;
-  std::unique_ptr<host::web::WebSessionHandler> session_;
-  int next_id_ = 1;
 };
 
 // Counts in the accumulator and copies it to user variable 0 (GGP 0, 2).
@@ -89,7 +38,7 @@ constexpr const char* kCounter =
     "       AGP 0, 2\n"
     "       JA Loop\n";
 
-class WebProgram : public testing::TestWithParam<const char*> {};
+class WebProgram : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(WebProgram, download_is_verified_and_reads_back_one_line_per_address) {
   ProgramRig rig(GetParam());
@@ -172,8 +121,8 @@ TEST_P(WebProgram, step_run_stop_reset_and_the_application_status) {
   EXPECT_EQ(outside["status"], 4);
 }
 
-INSTANTIATE_TEST_SUITE_P(TmclModules, WebProgram, testing::Values("tmcm-1636", "tmcm-142"),
-                         [](const testing::TestParamInfo<const char*>& param) {
+INSTANTIATE_TEST_SUITE_P(TmclModules, WebProgram, ::testing::Values("tmcm-1636", "tmcm-142"),
+                         [](const ::testing::TestParamInfo<const char*>& param) {
                            return std::string(param.param).substr(5);  // "1636", "142"
                          });
 
@@ -256,14 +205,12 @@ TEST(WebProgramOps, bad_requests_are_errors) {
 }
 
 TEST(WebProgramOps, a_canopen_node_takes_no_program_ops) {
-  host::ModuleOptions options;
-  options.log = [](const std::string&) {};
-  host::MakeModuleResult made = host::make_module("tmcm-3216", options);
+  host::MakeModuleResult made = motwin::testing::make_quiet_module("tmcm-3216");
   ASSERT_TRUE(made);
   host::HostRuntime runtime(**made, host::Pacing::fast());
   std::vector<ConsoleTarget> targets{canopen_target(*host::find_module("tmcm-3216"), "tmcm-3216", "x", 1)};
   WebConsole console(runtime.loop(), [] { return uint64_t{0}; }, std::move(targets), nullptr);
-  FakeConnection connection;
+  FakeWebConnection connection;
   auto session = console.open_session(connection);
   session->on_message(R"({"id": 7, "op": "app_status"})");
   ASSERT_EQ(connection.replies.size(), 1u);

@@ -16,20 +16,13 @@
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
 #include "host/tmcl_can_node.h"
+#include "support/web_console_rig.h"
 #include "tools/web/web_console.h"
 
 namespace motwin::tools::web {
 namespace {
 
 using Json = nlohmann::json;
-
-class FakeConnection final : public host::web::WebConnection {
- public:
-  void send_text(std::string message) override { messages.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override { messages.push_back(Json::parse(message)); }
-  size_t queued_bytes() const override { return 0; }
-  std::vector<Json> messages;
-};
 
 // Another CAN host on the same bus: records what it hears, sends what it is told.
 class OtherHost final : public host::CanBusEndpoint {
@@ -45,62 +38,24 @@ class OtherHost final : public host::CanBusEndpoint {
   host::CanBus::EndpointId id_ = 0;
 };
 
-class CanRig {
+// A TMCM-1636 as node tmcm-1636-1 of a virtual bus, the console reaching it by TMCL over CAN.
+// Requests are bounded in wall time: an unanswered one ends after TmclCanPort::kReplyTimeoutUs.
+class CanRig : public motwin::testing::WebConsoleRig {
  public:
-  CanRig() {
-    host::ModuleOptions options;
-    options.log = [](const std::string&) {};
-    host::MakeModuleResult made = host::make_module("tmcm-1636", options);
-    EXPECT_TRUE(made) << made.error();
-    module_ = std::move(*made);
-    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
-    bus_ = std::make_unique<host::CanBus>([this] { return module_->sim_time_us(); });
-    module_->can_node()->connect(*bus_);
-    std::vector<ConsoleTarget> targets;
-    targets.push_back(tmcl_target(*host::find_module("tmcm-1636"), "tmcm-1636-1",
-                                  std::string(module_->firmware_version()), "", nullptr, module_->tmcl_can_node()));
-    console_ = std::make_unique<WebConsole>(
-        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), bus_.get());
-    session_ = console_->open_session(connection_);
-    runtime_->start();
-  }
-  ~CanRig() {
-    session_.reset();
-    console_.reset();
-    module_->can_node()->disconnect();
-  }
+  CanRig()
+      : WebConsoleRig("tmcm-1636", motwin::testing::WebConsoleRigSetup()
+                                       .with_can_bus()
+                                       .with_reply_wait(motwin::testing::ReplyWait::kWallClock)
+                                       .with_target_adapter([](WebConsoleRig& rig, ConsoleTarget& target) {
+                                         target = tmcl_target(*host::find_module("tmcm-1636"), "tmcm-1636-1",
+                                                              std::string(rig.module().firmware_version()), "",
+                                                              nullptr, rig.module().tmcl_can_node());
+                                       })) {}
 
-  Json ask(Json request) {
-    request["id"] = next_id_++;
-    const size_t before = connection_.messages.size();
-    session_->on_message(request.dump());
-    // Bounded in wall time: an unanswered request ends after TmclCanPort::kReplyTimeoutUs.
-    const uint64_t give_up_us = host::monotonic_now_us() + 10'000'000;
-    while (host::monotonic_now_us() < give_up_us) {
-      for (size_t i = before; i < connection_.messages.size(); ++i) {
-        if (connection_.messages[i].value("id", Json()) == request["id"]) return connection_.messages[i];
-      }
-      runtime_->step(1000);
-    }
-    ADD_FAILURE() << "no reply to " << request.dump();
-    return Json{};
-  }
   void run_wall_us(uint64_t wall_us) {
     const uint64_t until_us = host::monotonic_now_us() + wall_us;
-    while (host::monotonic_now_us() < until_us) runtime_->step(1000);
+    while (host::monotonic_now_us() < until_us) runtime().step(1000);
   }
-  host::CanBus& bus() { return *bus_; }
-  host::VirtualModule& module() { return *module_; }
-  FakeConnection& connection() { return connection_; }
-
- private:
-  std::unique_ptr<host::VirtualModule> module_;
-  std::unique_ptr<host::HostRuntime> runtime_;
-  std::unique_ptr<host::CanBus> bus_;
-  std::unique_ptr<WebConsole> console_;
-  FakeConnection connection_;
-  std::unique_ptr<host::web::WebSessionHandler> session_;
-  int next_id_ = 1;
 };
 
 TEST(WebTmclOverCan, a_bus_node_is_listed_as_tmcl_with_its_ids_and_answers_with_its_own_checks) {

@@ -14,6 +14,7 @@
 
 #include "host/host_runtime.h"
 #include "host/module_registry.h"
+#include "support/web_console_rig.h"
 #include "tools/web/web_console.h"
 
 namespace motwin::tools::web {
@@ -21,62 +22,19 @@ namespace {
 
 using Json = nlohmann::json;
 
-class FakeConnection final : public host::web::WebConnection {
+// A console on one TMCL module whose world is set as `motwin serve --web` sets it. World ops
+// reply at once; TMCL requests when the module has served them.
+class WorldRig : public motwin::testing::WebConsoleRig {
  public:
-  void send_text(std::string message) override { replies.push_back(Json::parse(message)); }
-  void send_latest(std::string message) override { replies.push_back(Json::parse(message)); }
-  size_t queued_bytes() const override { return 0; }
+  explicit WorldRig(const char* module_name, const char* motor = "ideal")
+      : WebConsoleRig(module_name, motwin::testing::WebConsoleRigSetup().with_motor(motor).with_target_adapter(
+                                       [](WebConsoleRig& rig, ConsoleTarget& target) {
+                                         target.world = {&rig.module().signals(),
+                                                         [&rig](std::string_view signal, double value) {
+                                                           return rig.runtime().set_input_now(signal, value);
+                                                         }};
+                                       })) {}
 
-  std::vector<Json> replies;
-};
-
-std::unique_ptr<host::VirtualModule> make(const char* name, const char* motor) {
-  host::ModuleOptions options;
-  options.log = [](const std::string&) {};
-  options.motor = motor;
-  host::MakeModuleResult made = host::make_module(name, options);
-  EXPECT_TRUE(made) << made.error();
-  return std::move(*made);
-}
-
-// A console on one TMCL module whose world is set as `motwin serve --web` sets it.
-class WorldRig {
- public:
-  explicit WorldRig(const char* module_name, const char* motor = "ideal") : module_(make(module_name, motor)) {
-    runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
-    const host::ModuleDescriptor& descriptor = *host::find_module(module_name);
-    ConsoleTarget target = tmcl_target(descriptor, std::string(module_->name()),
-                                       std::string(module_->firmware_version()), "", &runtime_->service());
-    target.world = {&module_->signals(), [this](std::string_view signal, double value) {
-                      return runtime_->set_input_now(signal, value);
-                    }};
-    std::vector<ConsoleTarget> targets;
-    targets.push_back(std::move(target));
-    console_ = std::make_unique<WebConsole>(
-        runtime_->loop(), [this] { return module_->sim_time_us(); }, std::move(targets), nullptr);
-    session_ = console_->open_session(connection_);
-    runtime_->start();
-  }
-  ~WorldRig() {
-    session_.reset();
-    console_.reset();
-  }
-
-  // Sends the request and runs the module until its reply arrives (world ops reply at once;
-  // TMCL requests when the module has served them).
-  Json ask(Json request) {
-    request["id"] = next_id_++;
-    const size_t before = connection_.replies.size();
-    session_->on_message(request.dump());
-    for (int step = 0; step < 1'000'000; ++step) {
-      for (size_t i = before; i < connection_.replies.size(); ++i) {
-        if (connection_.replies[i]["id"] == request["id"]) return connection_.replies[i];
-      }
-      runtime_->step(0);
-    }
-    ADD_FAILURE() << "no reply to " << request.dump();
-    return Json{};
-  }
   int64_t gap(int number) {
     const Json reply = ask({{"op", "get"}, {"number", number}, {"axis", 0}});
     EXPECT_EQ(reply["ok"], true) << reply.dump();
@@ -87,17 +45,7 @@ class WorldRig {
     const Json values = ask({{"op", "world"}, {"values_only", true}})["values"];
     return values.value(name, Json(nullptr)).is_number() ? values[name].get<double>() : NAN;
   }
-  void run_for_ms(uint64_t ms) { runtime_->advance_ticks(ms * 1000 / module_->tick_period_us()); }
-  host::HostRuntime& runtime() { return *runtime_; }
-  host::VirtualModule& module() { return *module_; }
-
- private:
-  std::unique_ptr<host::VirtualModule> module_;
-  std::unique_ptr<host::HostRuntime> runtime_;
-  std::unique_ptr<WebConsole> console_;
-  FakeConnection connection_;
-  std::unique_ptr<host::web::WebSessionHandler> session_;
-  int next_id_ = 1;
+  void run_for_ms(uint64_t ms) { run_for_us(ms * 1000); }
 };
 
 const Json* signal_named(const Json& world, const std::string& name) {
@@ -132,9 +80,7 @@ TEST(WebWorld, world_lists_the_scenario_signals_with_range_unit_and_value_and_th
 }
 
 TEST(WebWorld, the_tmcm3216_has_three_axes_by_their_signal_prefix) {
-  host::ModuleOptions options;
-  options.log = [](const std::string&) {};
-  host::MakeModuleResult made = host::make_module("tmcm-3216", options);
+  host::MakeModuleResult made = motwin::testing::make_quiet_module("tmcm-3216");
   ASSERT_TRUE(made) << made.error();
   const ConsoleWorld world{&(*made)->signals(), {}};
   const Result<Json> reply = world_op("world", Json{{"op", "world"}}, 0, world, 0);
