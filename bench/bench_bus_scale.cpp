@@ -34,7 +34,7 @@
 #include <thread>
 #include <vector>
 
-#include "find_motwin.h"
+#include "end_to_end.h"
 #include "tools/canopen_client.h"
 #include "tools/serve_process.h"
 
@@ -49,23 +49,8 @@ int fail(const std::string& message) {
 }
 
 using motwin::bench::find_motwin_next_to_this_program;
+using motwin::bench::process_cpu_seconds;
 
-// User + system CPU seconds of a process so far.
-std::optional<double> process_cpu_seconds(pid_t pid) {
-  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const size_t close = text.rfind(')');
-  if (close == std::string::npos) return std::nullopt;
-  std::istringstream fields(text.substr(close + 2));
-  std::string field;
-  unsigned long long user = 0, system = 0;
-  // After the command: state (3) ... utime (14), stime (15).
-  for (int number = 3; number <= 15 && fields >> field; ++number) {
-    if (number == 14) user = std::stoull(field);
-    if (number == 15) system = std::stoull(field);
-  }
-  return static_cast<double>(user + system) / static_cast<double>(::sysconf(_SC_CLK_TCK));
-}
 
 enum class Module { kTmcm3216, kTmcm1636 };
 enum class Traffic { kIdle, kFull };

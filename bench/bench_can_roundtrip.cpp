@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "find_motwin.h"
+#include "end_to_end.h"
 #include "host/socketcand_protocol.h"
 #include "tools/canopen_client.h"
 #include "tools/serve_process.h"
@@ -46,6 +46,8 @@ int fail(const std::string& message) {
 }
 
 using motwin::bench::find_motwin_next_to_this_program;
+using motwin::bench::Percentiles;
+using motwin::bench::percentiles;
 
 // A bare socketcand server for one client: the session handshake, then each `< send ID ... >`
 // is answered with a frame on ID - 0x80 (0x601 -> 0x581: an SDO server's reply ID) carrying the
@@ -114,19 +116,7 @@ class BareSocketcandEcho {
   std::thread thread_;
 };
 
-struct Percentiles {
-  double median_us;
-  double p99_us;
-};
 
-Percentiles percentiles(std::vector<nanoseconds> samples) {
-  std::sort(samples.begin(), samples.end());
-  const auto at = [&](double fraction) {
-    const size_t index = std::min(samples.size() - 1, static_cast<size_t>(fraction * static_cast<double>(samples.size())));
-    return static_cast<double>(samples[index].count()) / 1e3;
-  };
-  return {at(0.5), at(0.99)};
-}
 
 using RoundTrip = std::function<bool()>;
 

@@ -22,7 +22,7 @@
 #include <thread>
 #include <vector>
 
-#include "find_motwin.h"
+#include "end_to_end.h"
 #include "core/tmcl/serial_link.h"
 #include "host/tmcl_host_service.h"
 #include "tools/fd_io.h"
@@ -58,6 +58,8 @@ int fail(const std::string& message) {
 }
 
 using motwin::bench::find_motwin_next_to_this_program;
+using motwin::bench::Percentiles;
+using motwin::bench::percentiles;
 
 std::optional<Options> parse_options(int argc, char** argv) {
   Options options;
@@ -98,10 +100,6 @@ std::optional<nanoseconds> timed_round_trip(tools::TmclClient& client, const tmc
   return std::chrono::duration_cast<nanoseconds>(elapsed);
 }
 
-struct Percentiles {
-  double median_us;
-  double p99_us;
-};
 
 // A connection to the serve that pipelines GAP 52 requests, kFloodWindow at a time, reading the
 // replies of each window before sending the next, until told to stop.
@@ -157,14 +155,6 @@ bool while_flooding(std::vector<FloodConnection>& connections, const tmcl::Frame
   return measured;
 }
 
-Percentiles percentiles(std::vector<nanoseconds> samples) {
-  std::sort(samples.begin(), samples.end());
-  const auto at = [&](double fraction) {
-    const size_t index = std::min(samples.size() - 1, static_cast<size_t>(fraction * static_cast<double>(samples.size())));
-    return static_cast<double>(samples[index].count()) / 1e3;
-  };
-  return {at(0.5), at(0.99)};
-}
 
 }  // namespace
 

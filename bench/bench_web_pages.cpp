@@ -32,7 +32,7 @@
 #include <thread>
 #include <vector>
 
-#include "find_motwin.h"
+#include "end_to_end.h"
 #include "tools/serve_process.h"
 #include "tools/tmcl_client.h"
 #include "tools/tmcl_mnemonics.h"
@@ -44,6 +44,9 @@
 namespace {
 
 using namespace motwin;
+using bench::Percentiles;
+using bench::percentiles;
+using bench::process_cpu_seconds;
 using Clock = std::chrono::steady_clock;
 using std::chrono::nanoseconds;
 
@@ -93,22 +96,6 @@ std::optional<Options> parse_options(int argc, char** argv) {
   return options;
 }
 
-// User + system CPU seconds of a process so far.
-std::optional<double> process_cpu_seconds(pid_t pid) {
-  std::ifstream file("/proc/" + std::to_string(pid) + "/stat");
-  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  const size_t close = text.rfind(')');
-  if (close == std::string::npos) return std::nullopt;
-  std::istringstream fields(text.substr(close + 2));
-  std::string field;
-  unsigned long long user = 0, system = 0;
-  // After the command: state (3) ... utime (14), stime (15).
-  for (int number = 3; number <= 15 && fields >> field; ++number) {
-    if (number == 14) user = std::stoull(field);
-    if (number == 15) system = std::stoull(field);
-  }
-  return static_cast<double>(user + system) / static_cast<double>(::sysconf(_SC_CLK_TCK));
-}
 
 // A serve under measurement: its TMCL client and its simulated clock.
 class Serve {
@@ -211,20 +198,7 @@ struct Totals {
   std::vector<nanoseconds> round_trips;
 };
 
-struct Percentiles {
-  double median_us;
-  double p99_us;
-};
 
-Percentiles percentiles(std::vector<nanoseconds> samples) {
-  std::sort(samples.begin(), samples.end());
-  const auto at = [&](double fraction) {
-    const size_t index =
-        std::min(samples.size() - 1, static_cast<size_t>(fraction * static_cast<double>(samples.size())));
-    return static_cast<double>(samples[index].count()) / 1e3;
-  };
-  return {at(0.5), at(0.99)};
-}
 
 // One block: `work` runs while the serve's CPU, simulated time and wall time (and the pages' CPU)
 // are taken around it.
