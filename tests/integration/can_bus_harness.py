@@ -1,6 +1,7 @@
 """Helpers for the bus tests (test_can_*.py, test_tmcl_can*.py, test_lss_*.py): a `motwin serve`
 whose every stdout line is parsed (one or several modules, every kind of CAN endpoint), a TMCL
-over CAN client on Debian's python3-can, and a free-port finder.
+over CAN client on Debian's python3-can, and a free-port finder. Its python-can helpers (open_bus,
+receive, collect) serve canopen_harness's CANopen client too.
 
 Builds on motwin_harness (process handling, watchdog, run_tests).
 """
@@ -61,14 +62,17 @@ def free_port():
 
 
 def open_bus(port, interface="socketcand", channel=None):
+    """A python-can bus on a socketcand or SLCAN-over-TCP endpoint of 127.0.0.1:`port`."""
     import can  # Debian's python3-can
     if interface == "slcan":
+        # A pyserial URL; python-can sleeps 2 s after opening a serial port unless told not to.
         return can.Bus(interface="slcan", channel=channel or f"socket://127.0.0.1:{port}", bitrate=1000000,
                        sleep_after_open=0)
     return can.Bus(interface="socketcand", host="127.0.0.1", port=port, channel="can0")
 
 
 def receive(bus, predicate, timeout, what="frame"):
+    """The first frame for which predicate(msg) is true; other frames are skipped."""
     deadline = time.monotonic() + timeout
     while True:
         remaining = deadline - time.monotonic()
@@ -80,6 +84,7 @@ def receive(bus, predicate, timeout, what="frame"):
 
 
 def collect(bus, duration, predicate=lambda msg: True):
+    """Every frame matching predicate within `duration` seconds (wall time)."""
     frames = []
     deadline = time.monotonic() + duration
     while True:

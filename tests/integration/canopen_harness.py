@@ -2,7 +2,8 @@
 and a raw-frame CANopen client on Debian's python3-can (socketcand interface).
 
 Builds on motwin_harness (process handling, the serve contract, watchdog, run_tests): CanServer
-only declares its banner and endpoint lines. Raw frames on purpose: what is checked is the wire, not a library's view.
+only declares its banner and endpoint lines. The python-can bus itself (opening, receiving,
+collecting) is can_bus_harness's. Raw frames on purpose: what is checked is the wire, not a library's view.
 """
 
 import itertools
@@ -10,6 +11,7 @@ import socket
 import struct
 import time
 
+import can_bus_harness
 import motwin_harness as mh
 from motwin_harness import FRAME_TIMEOUT, ServerError, TestFailure, check, check_equal  # noqa: F401 - re-exported
 
@@ -80,12 +82,7 @@ class CanopenClient:
         import can  # Debian's python3-can
         self.can = can
         self.stamps_simulated_time = interface == "socketcand"
-        if interface == "slcan":
-            # A pyserial URL; python-can sleeps 2 s after opening a serial port unless told not to.
-            self.bus = can.Bus(interface="slcan", channel=f"socket://127.0.0.1:{port}", bitrate=1000000,
-                               sleep_after_open=0)
-        else:
-            self.bus = can.Bus(interface="socketcand", host="127.0.0.1", port=port, channel="can0")
+        self.bus = can_bus_harness.open_bus(port, interface)
 
     def close(self):
         self.bus.shutdown()
@@ -101,26 +98,11 @@ class CanopenClient:
 
     def receive(self, predicate, timeout, what="frame"):
         """The first frame for which predicate(msg) is true; other frames are skipped."""
-        deadline = time.monotonic() + timeout
-        while True:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise TestFailure(f"timed out after {timeout} s waiting for {what}")
-            msg = self.bus.recv(remaining)
-            if msg is not None and predicate(msg):
-                return msg
+        return can_bus_harness.receive(self.bus, predicate, timeout, what)
 
     def collect(self, duration, predicate=lambda msg: True):
         """Every frame matching predicate within `duration` seconds (wall time)."""
-        frames = []
-        deadline = time.monotonic() + duration
-        while True:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                return frames
-            msg = self.bus.recv(remaining)
-            if msg is not None and predicate(msg):
-                frames.append(msg)
+        return can_bus_harness.collect(self.bus, duration, predicate)
 
     def drain(self, duration=0.05):
         self.collect(duration)
