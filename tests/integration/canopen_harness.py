@@ -63,6 +63,35 @@ class CanServer(mh.Server):
         return CanopenClient(self.slcan_port, interface="slcan")
 
 
+def check_store_and_restore_across_restart(serve, connect, node, store_more=lambda bus: None,
+                                           check_more_stored=lambda bus: None, check_more_restored=lambda bus: None):
+    """The storage contract of docs/canopen.md ("Device contract masters rely on"): what 1010 sub 1
+    ("save") stored comes back after a restart of the server, an unsaved 1015 does not, and the
+    defaults 1011 sub 1 ("load") restores apply at the next reset node, not before.
+
+    serve(): a new CanServer on the same state directory each time; connect(server): the client
+    the test speaks through (server.bus, server.slcan_bus). store_more(bus) sets what else the test
+    stores (before the save); check_more_stored(bus) checks it after the restart and
+    check_more_restored(bus) after the restore and reset."""
+    with serve() as server, connect(server) as bus:
+        bus.download(node, 0x1017, 0, 250, 2)
+        store_more(bus)
+        bus.download(node, 0x1010, 1, SAVE, 4)
+        bus.download(node, 0x1015, 0, 7, 2)  # not saved
+        server.stop()
+    with serve() as server, connect(server) as bus:
+        check_equal(bus.upload_u(node, 0x1017, 0), 250, "1017 after restart")
+        check_more_stored(bus)
+        check_equal(bus.upload_u(node, 0x1015, 0), 0, "unsaved 1015 after restart")
+        bus.download(node, 0x1011, 1, LOAD, 4)
+        check_equal(bus.upload_u(node, 0x1017, 0), 250, "restored defaults wait for a reset")
+        bus.nmt(NMT_RESET_NODE, node)
+        bus.wait_state(node, STATE_BOOTUP)
+        check_equal(bus.upload_u(node, 0x1017, 0), 0, "1017 after restore and reset")
+        check_more_restored(bus)
+        server.stop()
+
+
 class SdoAborted(TestFailure):
     def __init__(self, code, index, sub):
         super().__init__(f"SDO abort {code:08X} on {index:04X} sub {sub}")

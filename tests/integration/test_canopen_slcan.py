@@ -19,8 +19,9 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
-    STATE_PREOP, STATE_STOPPED, CanServer, TestFailure, check, check_equal, run_can_tests,
+    NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
+    STATE_PREOP, STATE_STOPPED, CanServer, TestFailure, check, check_equal, check_store_and_restore_across_restart,
+    run_can_tests,
 )
 from motwin_harness import FRAME_TIMEOUT, TempDir  # noqa: E402
 
@@ -131,25 +132,19 @@ def test_slcan_nmt_transitions(motwin):
 
 
 def test_slcan_store_and_restore_across_restart(motwin):
+    def store_more(bus):
+        bus.configure_pdo(NODE, 0x1802, 0x380 + NODE, 7, [DUMMY_U8])
+
+    def check_more_stored(bus):
+        check_equal(bus.upload_u(NODE, 0x1802, 2), 7, "1802 sub 2 after restart")
+        check_equal([bus.upload_u(NODE, 0x1A02, sub) for sub in (0, 1)], [1, DUMMY_U8], "1A02 after restart")
+
+    def check_more_restored(bus):
+        check_equal(bus.upload_u(NODE, 0x1802, 2), 1, "1802 sub 2 back to table 45's default")
+
     with TempDir() as tmp:
-        with serve(motwin, tmp) as server, server.slcan_bus() as bus:
-            bus.download(NODE, 0x1017, 0, 250, 2)
-            bus.configure_pdo(NODE, 0x1802, 0x380 + NODE, 7, [DUMMY_U8])
-            bus.download(NODE, 0x1010, 1, SAVE, 4)
-            bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
-            server.stop()
-        with serve(motwin, tmp) as server, server.slcan_bus() as bus:
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
-            check_equal(bus.upload_u(NODE, 0x1802, 2), 7, "1802 sub 2 after restart")
-            check_equal([bus.upload_u(NODE, 0x1A02, sub) for sub in (0, 1)], [1, DUMMY_U8], "1A02 after restart")
-            check_equal(bus.upload_u(NODE, 0x1015, 0), 0, "unsaved 1015 after restart")
-            bus.download(NODE, 0x1011, 1, LOAD, 4)
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "restored defaults wait for a reset")
-            bus.nmt(NMT_RESET_NODE, NODE)
-            bus.wait_state(NODE, STATE_BOOTUP)
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 0, "1017 after restore and reset")
-            check_equal(bus.upload_u(NODE, 0x1802, 2), 1, "1802 sub 2 back to table 45's default")
-            server.stop()
+        check_store_and_restore_across_restart(lambda: serve(motwin, tmp), CanServer.slcan_bus, NODE, store_more,
+                                               check_more_stored, check_more_restored)
 
 
 def lss_answer(bus, data, timeout=0.06):

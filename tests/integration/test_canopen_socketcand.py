@@ -17,8 +17,9 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from canopen_harness import (  # noqa: E402
-    LOAD, NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
-    STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, check, check_equal, run_can_tests,
+    NMT_PREOP, NMT_RESET_COMM, NMT_RESET_NODE, NMT_START, NMT_STOP, SAVE, STATE_BOOTUP, STATE_OPERATIONAL,
+    STATE_PREOP, STATE_STOPPED, CanServer, RawSocketcand, check, check_equal, check_store_and_restore_across_restart,
+    run_can_tests,
 )
 from motwin_harness import FRAME_TIMEOUT, TempDir  # noqa: E402
 
@@ -112,23 +113,15 @@ def test_nmt_start_stop_preop(motwin):
 
 
 def test_store_and_restore_across_restart(motwin):
+    def store_more(bus):
+        bus.download(NODE, 0x1029, 1, 2, 1)
+
+    def check_more_stored(bus):
+        check_equal(bus.upload_u(NODE, 0x1029, 1), 2, "1029 sub 1 after restart")
+
     with TempDir() as tmp:
-        with serve(motwin, tmp) as server, server.bus() as bus:
-            bus.download(NODE, 0x1017, 0, 250, 2)
-            bus.download(NODE, 0x1029, 1, 2, 1)
-            bus.download(NODE, 0x1010, 1, SAVE, 4)
-            bus.download(NODE, 0x1015, 0, 7, 2)  # not saved
-            server.stop()
-        with serve(motwin, tmp) as server, server.bus() as bus:
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "1017 after restart")
-            check_equal(bus.upload_u(NODE, 0x1029, 1), 2, "1029 sub 1 after restart")
-            check_equal(bus.upload_u(NODE, 0x1015, 0), 0, "unsaved 1015 after restart")
-            bus.download(NODE, 0x1011, 1, LOAD, 4)
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 250, "restored defaults wait for a reset")
-            bus.nmt(NMT_RESET_NODE, NODE)
-            bus.wait_state(NODE, STATE_BOOTUP)
-            check_equal(bus.upload_u(NODE, 0x1017, 0), 0, "1017 after restore and reset")
-            server.stop()
+        check_store_and_restore_across_restart(lambda: serve(motwin, tmp), CanServer.bus, NODE, store_more,
+                                               check_more_stored)
 
 
 def test_node_id_through_2705_and_2706(motwin):
