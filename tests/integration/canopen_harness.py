@@ -479,6 +479,25 @@ class CanopenClient:
             check_equal(mine, answer, f"LSS answer to {data[0]:#04x} as the listener saw it")
         return bool(answers)
 
+    def lss_fastscan(self, listener):
+        """python-canopen's LssMaster.fast_scan() in raw frames; the identity found, or None.
+        python-canopen takes silence within a time window for "no"; here `listener` tells for sure
+        (lss_answered), so that a loaded machine cannot turn a late "yes" into a "no"."""
+        def ask(id_number, bit_checked, lss_sub, lss_next):
+            frame = [0x51] + list(struct.pack("<I", id_number)) + [bit_checked, lss_sub, lss_next]
+            return self.lss_answered(frame, listener)
+
+        if not ask(0, 0x80, 0, 0):
+            return None
+        found = [0, 0, 0, 0]
+        for lss_sub in range(4):
+            for bit_checked in range(31, -1, -1):
+                if not ask(found[lss_sub], bit_checked, lss_sub, lss_sub):
+                    found[lss_sub] |= 1 << bit_checked
+            if not ask(found[lss_sub], 0, lss_sub, (lss_sub + 1) & 3):
+                return None
+        return found
+
     def lss_silent(self, data, wait=0.2):
         """Sends an LSS frame that must not be answered; returns the answers seen (should be [])."""
         self.send(0x7E5, list(data) + [0] * (8 - len(data)))

@@ -67,31 +67,11 @@ def test_inquire_configure_store_and_restart(motwin):
             server.stop()
 
 
-def fast_scan(bus, listener):
-    """python-canopen's LssMaster.fast_scan() in raw frames; the identity found, or None.
-    python-canopen takes silence within a time window for "no"; here `listener` tells for sure
-    (CanopenClient.lss_answered), so that a loaded machine cannot turn a late "yes" into a "no"."""
-    def ask(id_number, bit_checked, lss_sub, lss_next):
-        frame = [0x51] + list(struct.pack("<I", id_number)) + [bit_checked, lss_sub, lss_next]
-        return bus.lss_answered(frame, listener)
-
-    if not ask(0, 0x80, 0, 0):
-        return None
-    found = [0, 0, 0, 0]
-    for lss_sub in range(4):
-        for bit_checked in range(31, -1, -1):
-            if not ask(found[lss_sub], bit_checked, lss_sub, lss_sub):
-                found[lss_sub] |= 1 << bit_checked
-        if not ask(found[lss_sub], 0, lss_sub, (lss_sub + 1) & 3):
-            return None
-    return found
-
-
 def test_unconfigured_node_fastscan_configure_and_boot(motwin):
     with TempDir() as tmp:
         with serve(motwin, tmp) as server, server.bus() as bus, server.bus() as listener:
             ident = identity(bus, 1)
-            check_equal(fast_scan(bus, listener), None, "fastscan of a configured node")
+            check_equal(bus.lss_fastscan(listener), None, "fastscan of a configured node")
             bus.download(1, 0x2705, 0, 255, 1)
             bus.download(1, 0x2706, 1, SAVE, 4)
             server.stop()
@@ -99,7 +79,7 @@ def test_unconfigured_node_fastscan_configure_and_boot(motwin):
             bus.nmt(NMT_RESET_COMM, 0)
             bus.send(0x601, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
             check_equal(bus.collect(0.3, lambda m: m.arbitration_id != 0x7E4), [], "frames of an unconfigured node")
-            check_equal(fast_scan(bus, listener), ident, "identity found by fastscan")
+            check_equal(bus.lss_fastscan(listener), ident, "identity found by fastscan")
             check_equal(bus.lss([0x5E])[:2], bytes([0x5E, 255]), "inquire node ID: unconfigured")
             check_equal(bus.lss([0x11, 20])[:2], bytes([0x11, 0]), "configure node ID 20")
             check_equal(bus.lss([0x17])[:2], bytes([0x17, 0]), "store configuration")

@@ -159,25 +159,6 @@ def lss_answer(bus, data, timeout=0.06):
     return frames[0] if frames else None
 
 
-def fast_scan(bus, listener):
-    """python-canopen's LssMaster.fast_scan() in raw frames; the identity found, or None. A
-    socketcand `listener` tells whether a question was answered (CanopenClient.lss_answered)."""
-    def ask(id_number, bit_checked, lss_sub, lss_next):
-        return bus.lss_answered([0x51] + list(struct.pack("<I", id_number)) + [bit_checked, lss_sub, lss_next],
-                                listener)
-
-    if not ask(0, 0x80, 0, 0):
-        return None
-    found = [0, 0, 0, 0]
-    for lss_sub in range(4):
-        for bit_checked in range(31, -1, -1):
-            if not ask(found[lss_sub], bit_checked, lss_sub, lss_sub):
-                found[lss_sub] |= 1 << bit_checked
-        if not ask(found[lss_sub], 0, lss_sub, (lss_sub + 1) & 3):
-            return None
-    return found
-
-
 def test_slcan_lss_configure_and_fastscan(motwin):
     """Switch state selective, inquire, configure node ID and store on a configured node; then the
     node made unconfigured (2705 = 255), found by fastscan, configured and booted: all over SLCAN
@@ -200,14 +181,14 @@ def test_slcan_lss_configure_and_fastscan(motwin):
             bus.nmt(NMT_RESET_COMM, 1)
             bus.wait_state(23, STATE_BOOTUP)
             check_equal(bus.upload_u(23, 0x2705, 0), 23, "2705 stored by LSS")
-            check_equal(fast_scan(bus, listener), None, "fastscan of a configured node")
+            check_equal(bus.lss_fastscan(listener), None, "fastscan of a configured node")
             bus.download(23, 0x2705, 0, 255, 1)
             bus.download(23, 0x2706, 1, SAVE, 4)
             server.stop()
         with CanServer(motwin, state, can=endpoints) as server, server.slcan_bus() as bus, server.bus() as listener:
             bus.send(0x623, [0x40, 0x00, 0x10, 0, 0, 0, 0, 0])
             check_equal(bus.collect(0.3, lambda m: m.arbitration_id != 0x7E4), [], "frames of an unconfigured node")
-            check_equal(fast_scan(bus, listener), ident, "identity found by fastscan")
+            check_equal(bus.lss_fastscan(listener), ident, "identity found by fastscan")
             check_equal(lss_answer(bus, [0x11, 20], timeout=10.0)[:2], bytes([0x11, 0]), "configure node ID 20")
             bus.send(0x7E5, [0x04, 0, 0, 0, 0, 0, 0, 0])  # waiting: the unconfigured node boots at once
             bus.wait_state(20, STATE_BOOTUP)
