@@ -133,11 +133,32 @@ def expect_reply(reply, command, status=STATUS_OK, value=None, what=""):
 class ClientBase:
     """request() sends one frame and reads its 9-byte reply; helpers assert status 100."""
 
+    LINK = "link"  # names the link in failures: "TCP", "pty"
+
     def send_raw(self, data):
         raise NotImplementedError
 
-    def read_exact(self, n, timeout=REPLY_TIMEOUT):
+    def read_some(self, n, timeout):
+        """Up to `n` bytes, those that arrive within `timeout` seconds (b"" if none); None when the
+        server closed the link."""
         raise NotImplementedError
+
+    def close(self):
+        raise NotImplementedError
+
+    def read_exact(self, n, timeout=REPLY_TIMEOUT):
+        deadline = time.monotonic() + timeout
+        data = b""
+        while len(data) < n:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                raise TestFailure(f"{self.LINK}: timed out after {timeout} s with {len(data)} of {n} bytes: "
+                                  f"{data.hex(' ')}")
+            chunk = self.read_some(n - len(data), remaining)
+            if chunk is None:
+                raise TestFailure(f"{self.LINK}: connection closed by the server after {len(data)} of {n} bytes")
+            data += chunk
+        return data
 
     def read_available(self, timeout):
         """Whatever arrives within `timeout` seconds (b"" if nothing)."""
@@ -215,8 +236,16 @@ class ClientBase:
                 raise TestFailure(f"timed out after {timeout} s waiting for {description}")
             time.sleep(interval)
 
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
 
 class TcpClient(ClientBase):
+    LINK = "TCP"
+
     def __init__(self, port, host="127.0.0.1", timeout=5.0):
         self.sock = socket.create_connection((host, port), timeout=timeout)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
@@ -231,22 +260,12 @@ class TcpClient(ClientBase):
         self.sock.settimeout(REPLY_TIMEOUT)
         self.sock.sendall(data)
 
-    def read_exact(self, n, timeout=REPLY_TIMEOUT):
-        deadline = time.monotonic() + timeout
-        data = b""
-        while len(data) < n:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise TestFailure(f"TCP: timed out after {timeout} s with {len(data)} of {n} bytes: {data.hex(' ')}")
-            self.sock.settimeout(remaining)
-            try:
-                chunk = self.sock.recv(n - len(data))
-            except socket.timeout:
-                continue
-            if not chunk:
-                raise TestFailure(f"TCP: connection closed by the server after {len(data)} of {n} bytes")
-            data += chunk
-        return data
+    def read_some(self, n, timeout):
+        self.sock.settimeout(timeout)
+        try:
+            return self.sock.recv(n) or None
+        except socket.timeout:
+            return b""
 
     def read_available(self, timeout):
         self.sock.settimeout(timeout)
@@ -268,12 +287,6 @@ class TcpClient(ClientBase):
             self.sock.close()
         except OSError:
             pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 def _unsent_bytes(sock):
@@ -330,6 +343,8 @@ def wait_until_read_by_peer(sock, timeout=60.0):
 class SerialClient(ClientBase):
     """pyserial on the server's pseudo-terminal link, as a host application would open it."""
 
+    LINK = "pty"
+
     def __init__(self, link, baudrate=115200):
         import serial  # Debian's python3-serial
         self.port = serial.Serial(link, baudrate, timeout=1)
@@ -339,16 +354,9 @@ class SerialClient(ClientBase):
         self.port.write(data)
         self.port.flush()
 
-    def read_exact(self, n, timeout=REPLY_TIMEOUT):
-        deadline = time.monotonic() + timeout
-        data = b""
-        while len(data) < n:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise TestFailure(f"pty: timed out after {timeout} s with {len(data)} of {n} bytes: {data.hex(' ')}")
-            self.port.timeout = min(remaining, 1.0)
-            data += self.port.read(n - len(data))
-        return data
+    def read_some(self, n, timeout):
+        self.port.timeout = min(timeout, 1.0)
+        return self.port.read(n)
 
     def read_available(self, timeout):
         self.port.timeout = timeout
@@ -361,12 +369,6 @@ class SerialClient(ClientBase):
             self.port.close()
         except Exception:  # noqa: BLE001 - closing only
             pass
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()
 
 
 # --- The server -------------------------------------------------------------------------------
