@@ -431,10 +431,7 @@ class Server:
 
     # Lifecycle -------------------------------------------------------------------------------
     def start(self, timeout=STARTUP_TIMEOUT):
-        self._open_stderr_file()
-        self.proc = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True,
-                                     env=self.env)
+        self._spawn()
         try:
             self._read_until_ready(timeout)
         except BaseException:
@@ -447,10 +444,7 @@ class Server:
 
     def start_expect_failure(self, timeout=STARTUP_TIMEOUT):
         """Starts the server expecting it to exit before `ready`; returns its exit status."""
-        self._open_stderr_file()
-        self.proc = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True,
-                                     env=self.env)
+        self._spawn()
         try:
             out, _ = self.proc.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -460,6 +454,13 @@ class Server:
         self.returncode = self.proc.returncode
         check("ready" not in self.stdout_lines, f"serve printed 'ready' but then exited: {self.stdout_lines!r}")
         return self.returncode
+
+    def _spawn(self):
+        """Runs `motwin serve`: stdout a pipe the test reads, stderr an anonymous file."""
+        self._open_stderr_file()
+        self.proc = subprocess.Popen(self.args, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                     stderr=self._stderr_file, preexec_fn=_die_with_parent, close_fds=True,
+                                     env=self.env)
 
     def _read_until_ready(self, timeout):
         deadline = time.monotonic() + timeout
