@@ -62,17 +62,7 @@ uint16_t crc16_ccitt(const uint8_t* data, size_t length, uint16_t crc) {
 // --- Download ------------------------------------------------------------------------------------
 
 void SdoServer::initiate_block_download(const uint8_t* data) {
-  state_ = SdoState::kIdle;
-  index_ = multiplexer_index(data);
-  sub_ = data[3];
-  if (const SdoAbort found = dictionary_.find(index_, sub_, object_); found != SdoAbort::kNone) {
-    abort(index_, sub_, found);
-    return;
-  }
-  if (!writable(object_.info->access)) {
-    abort(index_, sub_, SdoAbort::kReadOnly);
-    return;
-  }
+  if (!open_object(data, Direction::kDownload)) return;
   size_indicated_ = (data[0] & kSizeIndicated) != 0;
   size_ = size_indicated_ ? le32(data + 4) : 0;
   const size_t object_size = dictionary_.size(object_);
@@ -161,15 +151,9 @@ void SdoServer::end_block_download(const uint8_t* data) {
 // --- Upload --------------------------------------------------------------------------------------
 
 void SdoServer::initiate_block_upload(const uint8_t* data) {
-  state_ = SdoState::kIdle;
-  index_ = multiplexer_index(data);
-  sub_ = data[3];
+  if (!open_object(data, Direction::kUpload)) return;
   const uint8_t requested_block_size = data[4];
   const uint8_t switch_threshold = data[5];
-  if (const SdoAbort found = dictionary_.find(index_, sub_, object_); found != SdoAbort::kNone) {
-    abort(index_, sub_, found);
-    return;
-  }
   if (requested_block_size == 0 || requested_block_size > kMaxBlockSize) {
     abort(index_, sub_, SdoAbort::kInvalidBlockSize);
     return;

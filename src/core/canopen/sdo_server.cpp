@@ -112,18 +112,23 @@ void SdoServer::handle(const can::CanFrame& request) {
   }
 }
 
-void SdoServer::initiate_download(const uint8_t* data) {
+bool SdoServer::open_object(const uint8_t* data, Direction direction) {
   state_ = SdoState::kIdle;
   index_ = multiplexer_index(data);
   sub_ = data[3];
   if (const SdoAbort found = dictionary_.find(index_, sub_, object_); found != SdoAbort::kNone) {
     abort(index_, sub_, found);
-    return;
+    return false;
   }
-  if (!writable(object_.info->access)) {
+  if (direction == Direction::kDownload && !writable(object_.info->access)) {
     abort(index_, sub_, SdoAbort::kReadOnly);
-    return;
+    return false;
   }
+  return true;
+}
+
+void SdoServer::initiate_download(const uint8_t* data) {
+  if (!open_object(data, Direction::kDownload)) return;
   const bool expedited = (data[0] & 0x02) != 0;
   const bool size_indicated = (data[0] & 0x01) != 0;
   const size_t object_size = dictionary_.size(object_);
@@ -190,13 +195,7 @@ void SdoServer::download_segment(const uint8_t* data) {
 }
 
 void SdoServer::initiate_upload(const uint8_t* data) {
-  state_ = SdoState::kIdle;
-  index_ = multiplexer_index(data);
-  sub_ = data[3];
-  if (const SdoAbort found = dictionary_.find(index_, sub_, object_); found != SdoAbort::kNone) {
-    abort(index_, sub_, found);
-    return;
-  }
+  if (!open_object(data, Direction::kUpload)) return;
   size_t length = 0;
   if (const SdoAbort read = load_upload(length); read != SdoAbort::kNone) {
     abort(index_, sub_, read);

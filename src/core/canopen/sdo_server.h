@@ -79,6 +79,11 @@ class SdoServer {
  private:
   static uint16_t multiplexer_index(const uint8_t* data);
   void handle(const can::CanFrame& request);
+  // Every initiation's start: the server goes idle, the request's multiplexer becomes the
+  // transfer's object. False, after the abort, when the object does not exist or a download's is
+  // not writable.
+  enum class Direction : uint8_t { kUpload, kDownload };
+  bool open_object(const uint8_t* data, Direction direction);
   void initiate_download(const uint8_t* data);
   void download_segment(const uint8_t* data);
   void initiate_upload(const uint8_t* data);
