@@ -3,7 +3,6 @@
 a script (python3-websocket) as docs/web-console.md describes it, checked against what a TMCL host
 on the same serve sees over TCP."""
 
-import json
 import os
 import sys
 
