@@ -9,7 +9,8 @@
 // - every SDO answer is the one the client expects (fuzz::SdoClientView, canopen_checks.h): one
 //   response per request, index echoed, CiA-301 abort codes; a write acknowledged without abort
 //   reads back as written (a mapping entry, a COB-ID), an aborted one changes nothing;
-// - every frame the device sends is a classic data frame of at most 8 bytes; EMCY frames have 8.
+// - every frame the device sends is a classic data frame of at most 8 bytes; EMCY frames have 8
+//   (a frame on the EMCY's identifier that a valid TPDO also has is that TPDO's).
 #include <fuzzer/FuzzedDataProvider.h>
 
 #include <cstddef>
@@ -105,12 +106,24 @@ class PdoFuzzer {
     check_output(node, [](const can::CanFrame&) {});
   }
 
+  // CiA-301 restricts neither 81h..FFh for a PDO: a TPDO given the EMCY's identifier sends its
+  // frames there, and they are no EMCYs (campaign finding of 2026-11-27, fuzz/README.md).
+  bool is_tpdo_identifier(uint32_t id) {
+    for (const uint16_t axis_offset : {0x00, 0x40, 0x80}) {
+      for (uint16_t number = 0; number < 4; ++number) {
+        const uint32_t cob_id = read_u32(static_cast<uint16_t>(0x1800 + number + axis_offset), 1);
+        if ((cob_id & canopen::kPdoCobIdInvalid) == 0 && (cob_id & 0x1FFF'FFFF) == id) return true;
+      }
+    }
+    return false;
+  }
+
   template <class OnSdoResponse>
   void check_output(uint8_t node, OnSdoResponse on_sdo_response) {
     for (const can::CanFrame& out : rig_.can.frames) {
       fuzz::trace("  <-", out);
       FUZZ_CHECK(out.dlc <= 8 && !out.rtr && out.id <= can::kMaxStandardId, "frame %x dlc %u", out.id, out.dlc);
-      if (out.id == 0x80u + node) FUZZ_CHECK(out.dlc == 8, "EMCY with %u bytes", out.dlc);
+      if (out.id == 0x80u + node && !is_tpdo_identifier(out.id)) FUZZ_CHECK(out.dlc == 8, "EMCY with %u bytes", out.dlc);
       if (out.id == canopen::kSdoResponseCobIdBase + node) on_sdo_response(out);
     }
     client_.after(rig_.can.frames);

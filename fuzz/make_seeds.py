@@ -484,6 +484,10 @@ def canopen_pdo_seeds():
     def seed(name, steps):
         write("canopen_pdo", name, steps.f.data())
 
+    # 2026-11-27: a TPDO given the EMCY's identifier 81h (fuzz/README.md "Findings": the target's
+    # EMCY check, not the module, was wrong), kept byte for byte.
+    write("canopen_pdo", "finding_2026_11_27_tpdo_on_the_emcy_identifier", base64.b64decode("gSDlAgAA"))
+
     # Default RPDOs of axis 0 (6040; 6040 + 6060; 6040 + 607A; 6040 + 60FF), then lengths off by one.
     seed("default_rpdos", Steps().nmt(0x01).rpdo(0, 0, [0x06, 0x00]).rpdo(1, 0, [0x0F, 0x00, 0x01])
          .rpdo(2, 0, [0x0F, 0x00, 0x10, 0x27, 0, 0]).rpdo(3, 0, [0x0F, 0x00, 0xE8, 0x03, 0, 0]).rpdo(0, 0, [0x06])
@@ -613,6 +617,12 @@ TMCM3216_DRIVE_FINDINGS = [
 ]
 
 
+# 2026-11-27: SAP 255 1 left AP 17 (set in TMC457 units) beyond the range of µsteps/s² (fuzz/README.md
+# "Findings"; Tmcm142Parameters.a_switch_to_unit_mode_1_lowers_accelerations_beyond_its_range).
+TMCM142_ENGINE_FINDINGS = [
+    ("finding_2026_11_27_unit_mode_1_acceleration_beyond_range", "DX/34wQVE8e7T4sFJFE="),
+]
+
 def engine_seeds():
     # The ramp, homing, TMCM-3216 drive and TMCM-142 engine targets read FuzzedDataProvider input
     # too; their own generator, so that the seeds of the targets above stay as they are.
@@ -626,6 +636,8 @@ def engine_seeds():
         write("eight_point_ramp", name, base64.b64decode(text))
     for name, text in TMCM3216_DRIVE_FINDINGS:
         write("tmcm3216_drive", name, base64.b64decode(text))
+    for name, text in TMCM142_ENGINE_FINDINGS:
+        write("tmcm142_engine", name, base64.b64decode(text))
     # tmcm3216_drive's last byte is its bring-up: bits 0-2 the axes enabled, 3-5 the mode
     # (pp, pv, hm, csp, csv, ...), 6 no NMT start, 7 limit switches off (2005 = 3).
     for bring_up in (0x07, 0x0F, 0x17, 0x1F, 0x27, 0x81, 0x89, 0x91, 0x99, 0xA1, 0xC7):

@@ -114,6 +114,25 @@ TEST(Tmcm142Parameters, unit_mode_converts_speeds_and_accelerations) {
   EXPECT_EQ(rig.command(1, 0, 0, INT32_MAX).status, kOk);
 }
 
+// Fuzz finding (tmcm142_engine, 2026-11-27): AP 17 set to the top of its TMC457 range read
+// 244140610 after SAP 255 1, beyond its range 0..16777215.
+TEST(Tmcm142Parameters, a_switch_to_unit_mode_1_lowers_accelerations_beyond_its_range) {
+  Tmcm142Rig rig;
+  ASSERT_EQ(rig.sap(5, 16777215), kOk);  // TMC457 units: about 2.4e8 µsteps/s²
+  ASSERT_EQ(rig.sap(15, 16777215), kOk);
+  ASSERT_EQ(rig.sap(17, 16777215), kOk);
+  ASSERT_EQ(rig.sap(255, 1), kOk);
+  for (uint8_t ap : {5, 15, 16, 17}) EXPECT_EQ(rig.gap(ap), 16777215) << "AP " << int{ap};
+  EXPECT_DOUBLE_EQ(rig.module.axis().config.acceleration_pps2, 16777215.0);
+  EXPECT_DOUBLE_EQ(rig.module.axis().config.deceleration_pps2, 16777215.0);
+  // Below the bound nothing changes: 100000 µsteps/s² in TMC457 units and back.
+  ASSERT_EQ(rig.sap(255, 0), kOk);
+  ASSERT_EQ(rig.sap(5, 6872), kOk);
+  const double acceleration = rig.module.axis().config.acceleration_pps2;
+  ASSERT_EQ(rig.sap(255, 1), kOk);
+  EXPECT_DOUBLE_EQ(rig.module.axis().config.acceleration_pps2, acceleration);
+}
+
 TEST(Tmcm142Parameters, stored_speeds_come_back_in_their_unit_mode) {
   Tmcm142Rig rig;
   ASSERT_EQ(rig.sap(255, 1), kOk);

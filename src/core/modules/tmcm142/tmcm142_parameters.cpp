@@ -74,6 +74,21 @@ constexpr Binding<Tmcm142> acceleration_field() {
           }};
 }
 
+// AP 255. TMC457 units reach 14.6 times further than the µsteps/s² of unit mode 1 (both
+// 1..16777215 on the wire): a switch to mode 1 lowers each acceleration above 16777215 µsteps/s²
+// to it, so that AP 5, 15, 16 and 17 still read inside their range (fuzz finding of 2026-11-27).
+constexpr Binding<Tmcm142> kUnitMode{
+    [](Tmcm142& m, uint8_t) { return static_cast<int32_t>(m.axis().config.unit_mode); },
+    [](Tmcm142& m, uint8_t, int32_t value) {
+      AxisConfig& config = m.axis().config;
+      config.unit_mode = static_cast<UnitMode>(value);
+      if (pps_mode(m)) {
+        for (double* pps2 : {&config.acceleration_pps2, &config.stop_deceleration_pps2, &config.deceleration_pps2}) {
+          *pps2 = std::min(*pps2, static_cast<double>(kMaxAccelerationInternal));
+        }
+      }
+      return Status::kOk;
+    }};
 constexpr Binding<Tmcm142> kTargetSpeed{
     [](Tmcm142& m, uint8_t) { return speed_to_wire(m, m.axis().state.target_velocity_pps); },
     [](Tmcm142& m, uint8_t, int32_t value) {
@@ -165,7 +180,7 @@ const Tmcm142::Table& Tmcm142::axis_parameters() {
     {{196, "reference switch distance", kMin32, kMax32, 0, access("R"), Unit::kMicrosteps, "End switch distance: right minus left switching point, measured by modes 2 and 3"}, state_value<&AxisState::travel>()},
     {{207, "extended error flags", 0, 3, 0, access("R"), Unit::kNone, "Bit 1 stopped by encoder deviation (bit 0 is never set by Motwin); cleared by reading"}, axis_value<&Tmcm142Axis::take_error_flags>()},
     {{212, "max. encoder deviation", 0, kMax32, 0, access("RWE"), Unit::kMicrosteps, "|encoder - actual position| above it stops the motor and sets EDV; 0 off"}, config_field<&AxisConfig::max_encoder_deviation>()},
-    {{255, "unit mode", 0, 1, 0, access("RWE"), Unit::kNone, "Speeds and accelerations: 0 TMC457 units, 1 µsteps/s and µsteps/s²"}, config_field<&AxisConfig::unit_mode>()},
+    {{255, "unit mode", 0, 1, 0, access("RWE"), Unit::kNone, "Speeds and accelerations: 0 TMC457 units, 1 µsteps/s and µsteps/s² (accelerations above 16777215 µsteps/s² are lowered to it)"}, kUnitMode},
   };
   // clang-format on
   static constexpr Table kTable = params::sorted_table<Tmcm142>(kRows);
