@@ -92,11 +92,10 @@ campaign_commit() {
 }
 
 campaign_target() {  # target seconds runs
-  local target=$1 time=$2 runs=$3 log corpus findings before after start elapsed cpu
+  local target=$1 time=$2 runs=$3 log corpus findings start elapsed cpu
   corpus="$build/corpus/$target"
   mkdir -p "$corpus" "$build/campaign"
   log="$build/campaign/$target-$(date -u +%Y%m%dT%H%M%S).log"
-  before=$(find "$build/artifacts" -maxdepth 1 -name "$target-*" ! -name '*.log' | sort)
   start=$(date +%s.%N)
   # -runs counts every execution (seed replay included); -print_final_stats=1 gives the totals and
   # the last status line cov/ft. The sanitizer options and -timeout are the smoke's.
@@ -115,8 +114,9 @@ campaign_target() {  # target seconds runs
   ft=$(echo "$status" | grep -o 'ft: [0-9]*' | grep -o '[0-9]*$' || true)
   corp=$(echo "$status" | grep -o 'corp: [0-9]*/[0-9]*[a-zA-Z]*' | sed 's/corp: //' || true)
   rate=$(awk -v n="${executions:-0}" -v s="$elapsed" 'BEGIN {printf "%d", (s > 0 ? n / s : 0)}')
-  after=$(find "$build/artifacts" -maxdepth 1 -name "$target-*" ! -name '*.log' | sort)
-  findings=$(comm -13 <(echo "$before") <(echo "$after") | xargs -r -n1 basename | sed 's/^'"$target"'-//' |
+  # The inputs this part saved, as its own log names them (parts of one target running side by side
+  # share the artifacts folder, so a listing of it would give one part's crash to the other).
+  findings=$(sed -n 's/.*Test unit written to \([^ ]*\).*/\1/p' "$log" | xargs -r -n1 basename | sed 's/^'"$target"'-//' |
     paste -sd ' ' -)
   if [ -n "$findings" ]; then
     findings="$(grep -m1 -oE 'invariant violated at [^ ]*|ERROR: [A-Za-z]+: [a-z-]+|ERROR: libFuzzer: [a-z-]+|runtime error: .{0,50}' "$log" |
