@@ -614,6 +614,9 @@ TMCM3216_DRIVE_FINDINGS = [
      "GgAVEiQZAAAAAIEAAACA////fwDIAAAAAAAAAMgAAADIAAAAyAAApstIET8Eu/QKjA9SGdYRUFq+0lX0SJeOZgNhZhifZS7x1W9X"
      "P2ycDS9Ogr7G7wmDYZGfGkfHqzMnygAAx+ZZyW0yf3vk4EYJ/zPqK3V8jD81m66vh9E+ZYpESe/CrccwV6oPYULqv+q6n/VGSQlK"
      "xpUAAMgAAADIAAA9StSF8L2NGSQSFbnSPCAKxQNyMqi7JZLnNz0U2EMf"),
+    # 2026-11-27: full steps (2000 = 0) taken at switch-off snapped the field to the nearest full step
+    # (Tmcm3216Stepper.NewResolutionNearTheEndOfTheElectricalCircleKeepsTheField).
+    ("finding_2026_11_27_new_resolution_snapped_the_field", "P5k7BdglckktlwcCcbCVGvVlOCZSqNijGVBfbEBNc/kH"),
 ]
 
 

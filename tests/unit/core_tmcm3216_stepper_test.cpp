@@ -137,9 +137,35 @@ TEST(Tmcm3216Stepper, NewResolutionAppliesWhileThePowerStageIsOff) {
   axis.tick();
   EXPECT_FALSE(axis.stage.drive.enabled);
   EXPECT_EQ(axis.stepper.active_microstep_code(), 4);
+  // The field stays where the old resolution left it, off the new grid: snapping it to the nearest
+  // 1/16 step would pull the rotor there at the next switch-on (fuzz finding, fuzz/README.md).
+  EXPECT_EQ(axis.stage.drive.electrical_angle, 1u << 22);
   axis.enable();
-  axis.move(1);  // one 1/16 step, from the nearest 1/16 step of the old angle
-  EXPECT_EQ(axis.stage.drive.electrical_angle, 1u << 26);
+  axis.tick();
+  EXPECT_EQ(axis.stage.drive.electrical_angle, 1u << 22);
+  axis.move(1);  // one 1/16 step from there
+  EXPECT_EQ(axis.stage.drive.electrical_angle, (1u << 22) + (1u << 26));
+}
+
+TEST(Tmcm3216Stepper, NewResolutionNearTheEndOfTheElectricalCircleKeepsTheField) {
+  // The fuzz finding: 1/256 steps down to just below a full circle, then full steps (2000 = 0)
+  // taken at switch-off; the driver's angle must not wrap to the nearest full step (0).
+  Axis axis;
+  axis.enable();
+  axis.tick();
+  axis.move(-63);  // 63/256 of a full step below a whole electrical circle: 0xF0400000
+  const uint32_t angle = axis.stage.drive.electrical_angle;
+  EXPECT_EQ(angle, 0xF0400000u);
+  axis.stepper.objects.microstep_code = 0;
+  axis.disable();
+  for (int i = 0; i < 4; ++i) {
+    axis.tick();
+    EXPECT_EQ(axis.stage.drive.electrical_angle, angle);
+  }
+  EXPECT_EQ(axis.stepper.active_microstep_code(), 0);
+  axis.enable();
+  axis.move(1);  // one full step on from the kept field
+  EXPECT_EQ(axis.stage.drive.electrical_angle, angle + (1u << 30));
 }
 
 TEST(Tmcm3216Stepper, SwitchesAfterInvertAndDisable) {

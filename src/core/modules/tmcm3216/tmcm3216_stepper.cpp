@@ -311,10 +311,9 @@ bool Tmcm3216Stepper::standstill_time_read_alike(uint32_t dt_us) const {
 void Tmcm3216Stepper::write_drive(board::StepperDrive& drive) {
   // 2097 = 0 switches all bridge transistors off: the motor freewheels.
   drive.enabled = power_on_ && objects.chopper_off_time != 0;
-  // The driver's table moves in whole microsteps of the active resolution.
-  const uint32_t per_microstep = board::kElectricalAnglePerFullStep >> active_microstep_code_;
-  const uint64_t quantized = (uint64_t{electrical_angle_} + per_microstep / 2) / per_microstep * per_microstep;
-  drive.electrical_angle = static_cast<uint32_t>(quantized);
+  // The field moves only by steps of the active resolution. A new resolution (2000) steps on from
+  // where the old one left the field, off its grid: snapping to the new grid would move the rotor.
+  drive.electrical_angle = electrical_angle_;
   const motion::CoilCurrents currents = motion::coil_currents(drive.electrical_angle, drive.enabled ? current_ma_ : 0);
   drive.coil_a_ma = currents.coil_a_ma;
   drive.coil_b_ma = currents.coil_b_ma;
