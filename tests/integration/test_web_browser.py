@@ -419,26 +419,46 @@ def test_canopen_view(motwin):
                 "return [...document.querySelectorAll('#monitor tbody tr')].map(r => [...r.cells].map(c => c.textContent));")
         browser.wait("heartbeats in the monitor", lambda: any(
             row[2] == "Heartbeat 1" and row[4] == "operational" for row in monitor_rows()))
-        # TPDO 1 is event driven (statusword changes) and the monitor keeps the last 500 frames, so
-        # the TPDOs of the controlwords above may have scrolled out (seen under load): a change now.
-        for controlword, expected in ((7, "Switched on"), (15, "Operation enabled")):
+        monitor_note = lambda: browser.find("#monitor-note").text  # noqa: E731
+        monitor_frames = lambda: int(monitor_note().split(" frames")[0].split("· ")[-1])  # noqa: E731
+
+        # TPDO 1 is event driven (statusword changes) and the monitor keeps the last 500 frames; under
+        # load the TPDOs of the controlwords above may have scrolled out, or a slow page had the
+        # server drop them (both seen). So statusword changes until one shows: switched on and
+        # operation enabled in turn, the next one once the page shows the state and has had 20
+        # frames more since (frames reach the page in order, so the TPDO would be among them).
+        toggle = {"count": 0, "expected": None, "frames_at_state": None}
+
+        def tpdo_1_shown():
+            if any(row[2] == "TPDO 1 node 1" and row[1] == "0x181" for row in monitor_rows()):
+                return True
+            if toggle["expected"] is not None:
+                if toggle["frames_at_state"] is None:
+                    if canopen_axis_cell(browser, 0, "cia402-state") == toggle["expected"]:
+                        toggle["frames_at_state"] = monitor_frames()
+                    return False
+                if monitor_frames() <= toggle["frames_at_state"] + 20:
+                    return False
+            controlword, expected = ((7, "Switched on"), (15, "Operation enabled"))[toggle["count"] % 2]
             check(console.ask("sdo_write", module=0, index=0x6040, sub=0, value=controlword)["ok"],
                   f"controlword {controlword}")
-            browser.wait(f"axis 0 {expected} again", lambda: canopen_axis_cell(browser, 0, "cia402-state") == expected)
-        browser.wait("TPDO 1 in the monitor", lambda: any(
-            row[2] == "TPDO 1 node 1" and row[1] == "0x181" for row in monitor_rows()))
+            toggle.update(count=toggle["count"] + 1, expected=expected, frames_at_state=None)
+            return False
+
+        browser.wait("TPDO 1 in the monitor", tpdo_1_shown)
+        check(console.ask("sdo_write", module=0, index=0x6040, sub=0, value=15)["ok"], "controlword 15")
+        browser.wait("axis 0 operation enabled again",
+                     lambda: canopen_axis_cell(browser, 0, "cia402-state") == "Operation enabled")
         browser.wait("the view's SDO requests in the monitor", lambda: any(
             row[2] == "SDO request 1" and row[4].startswith("initiate upload 6041.0") for row in monitor_rows()))
-        monitor_note = lambda: browser.find("#monitor-note").text  # noqa: E731
         browser.find("#monitor-hide-sdo").click()
         browser.find("#monitor-clear").click()
         browser.wait("frames without SDO", lambda: len(monitor_rows()) >= 3)
         check(not any(row[2].startswith("SDO") for row in monitor_rows()), "SDO hidden")
         browser.find("#monitor-pause").click()
         paused_rows = len(monitor_rows())
-        paused_frames = int(monitor_note().split(" frames")[0].split("· ")[-1])
-        browser.wait("frames counted while paused", lambda: int(monitor_note().split(" frames")[0].split("· ")[-1])
-                     > paused_frames + 20)
+        paused_frames = monitor_frames()
+        browser.wait("frames counted while paused", lambda: monitor_frames() > paused_frames + 20)
         check_equal(len(monitor_rows()), paused_rows, "no rows added while paused")
         browser.find("#monitor-pause").click()
         browser.find("#monitor-hide-sdo").click()
