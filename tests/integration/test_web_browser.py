@@ -423,9 +423,9 @@ def test_canopen_view(motwin):
         monitor_frames = lambda: int(monitor_note().split(" frames")[0].split("· ")[-1])  # noqa: E731
 
         # TPDO 1 is event driven (statusword changes) and the monitor keeps the last 500 frames; under
-        # load the TPDOs of the controlwords above may have scrolled out, or a slow page had the
-        # server drop them (both seen). So statusword changes until one shows: switched on and
-        # operation enabled in turn, the next one once the page shows the state and has had 20
+        # load the TPDOs of the controlwords above can scroll out, or a slow page has the server drop
+        # them (a lost TPDO was seen under load). So statusword changes until one shows: switched on
+        # and operation enabled in turn, the next one once the page shows the state and has had 20
         # frames more since (frames reach the page in order, so the TPDO would be among them).
         toggle = {"count": 0, "expected": None, "frames_at_state": None}
 
