@@ -132,7 +132,10 @@ campaign_target() {  # target seconds runs
     "$built_commit" "$target" "$elapsed" "$cpu" "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" \
     "${corp:-?}" "$findings")
   # Append under the table's last row (the table is the last block of lines starting with '|' after
-  # the "## Campaigns" heading).
+  # the "## Campaigns" heading). Parts side by side may end together: one appends at a time (the
+  # lock), else one part's rewrite of the file drops the other's row (seen 2026-11-27).
+  exec 9>"$build/campaign/readme.lock"
+  flock 9
   awk -v row="$row" '
     { lines[NR] = $0 }
     /^## Campaigns/ { section = NR }
@@ -141,7 +144,8 @@ campaign_target() {  # target seconds runs
       for (i = section + 1; i <= NR && section; ++i) if (lines[i] ~ /^\|/) last = i; else if (last) break
       for (i = 1; i <= NR; ++i) { print lines[i]; if (i == last) print row }
       if (!last) print row
-    }' fuzz/README.md >fuzz/README.md.new && mv fuzz/README.md.new fuzz/README.md
+    }' fuzz/README.md >"fuzz/README.md.new.$$" && mv "fuzz/README.md.new.$$" fuzz/README.md
+  exec 9>&-
   [ "$findings" = none ]
 }
 
