@@ -134,9 +134,9 @@ campaign_target() {  # target seconds runs
   row=$(printf '| %s | %s | %s | %.0f | %s | %s | %s | %s | %s | %s | %s |' "$(date -u +%Y-%m-%d)" \
     "$built_commit" "$target" "$elapsed" "$cpu" "${executions:-?}" "$rate" "${cov:-?}" "${ft:-?}" \
     "${corp:-?}" "$findings")
-  # Append under the table's last row (the table is the last block of lines starting with '|' after
-  # the "## Campaigns" heading). Parts side by side may end together: one appends at a time (the
-  # lock), else one part's rewrite of the file drops the other's row (seen 2026-11-27).
+  # Append under the table's last row (the table is the first block of lines starting with '|'
+  # after the "## Campaigns" heading). Parts side by side may end together: one appends at a time
+  # (the lock), else one part's rewrite of the file drops the other's row (seen 2026-11-27).
   exec 9>"$build/campaign/readme.lock"
   flock 9
   awk -v row="$row" '
