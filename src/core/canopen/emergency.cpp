@@ -1,6 +1,18 @@
 #include "core/canopen/emergency.h"
 
+#include "core/canopen/cob_id.h"
+
 namespace motwin::canopen {
+
+SdoAbort check_emcy_cob_id(uint32_t current, int64_t value, uint8_t node_id) {
+  constexpr uint32_t kInvalid = 0x8000'0000;
+  constexpr uint32_t kMask = 0x7FF;
+  const uint32_t v = static_cast<uint32_t>(value);
+  if ((v & 0x7FFF'F800) != 0) return SdoAbort::kInvalidValue;
+  if ((v & kInvalid) != 0) return SdoAbort::kNone;
+  if ((current & kInvalid) == 0 && ((v ^ current) & kMask) != 0) return SdoAbort::kInvalidValue;
+  return restricted_can_id(v & kMask) && (v & kMask) != 0x80u + node_id ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+}
 
 void EmergencyProducer::reset() {
   head_ = 0;

@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "board/can_controller.h"
+#include "core/canopen/sdo_abort.h"
 #include "types/can_frame.h"
 
 namespace motwin::canopen {
@@ -30,6 +31,11 @@ inline constexpr uint8_t kErrorRegisterTemperature = 0x08;
 inline constexpr uint8_t kErrorRegisterCommunication = 0x10;
 inline constexpr uint8_t kErrorRegisterDeviceProfile = 0x20;
 inline constexpr uint8_t kErrorRegisterManufacturer = 0x80;
+
+// An SDO write of 1014 (`current` is its value now) on node `node_id`: bit 31 switches EMCY off;
+// 11-bit identifiers only; the ID does not change while valid; no restricted identifier but the
+// node's own default 80h + node ID.
+SdoAbort check_emcy_cob_id(uint32_t current, int64_t value, uint8_t node_id);
 
 class EmergencyProducer {
  public:

@@ -7,11 +7,18 @@
 
 #include <cstdint>
 
+#include "core/canopen/sdo_abort.h"
 #include "types/can_frame.h"
 
 namespace motwin::canopen {
 
 enum class HeartbeatEvent : uint8_t { kNone, kTimeout, kRecovered };
+
+// An SDO write of a 1016 entry: bits 31..24 reserved, node ID 1..127 in bits 23..16 (or 0: unused).
+constexpr SdoAbort check_consumer_heartbeat_entry(int64_t value) {
+  const uint32_t v = static_cast<uint32_t>(value);
+  return (v >> 24) != 0 || ((v >> 16) & 0xFF) > 127 ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+}
 
 class HeartbeatConsumer {
  public:

@@ -125,6 +125,44 @@ class ObjectDictionary {
   ~ObjectDictionary() = default;
 };
 
+// A dictionary made of rows (EntryInfo), as every module's is: what the services that walk every
+// object (storage, the node's resets) and the "$NODEID+" defaults need besides lookup and access.
+class RowDictionary : public ObjectDictionary {
+ public:
+  // The rows in table order.
+  virtual size_t row_count() const = 0;
+  virtual const EntryInfo& row_info(size_t row) const = 0;
+  // The current value of a numeric entry, whatever its access.
+  virtual int64_t value(const ObjectRef& ref) = 0;
+  // Stores without the SDO checks: defaults and stored values at reset.
+  virtual void store(const ObjectRef& ref, int64_t new_value) = 0;
+
+  uint8_t axis_count() const { return axis_count_; }
+  // The node ID that "$NODEID+" defaults add.
+  void set_node_id(uint8_t node_id) { node_id_ = node_id; }
+  uint8_t node_id() const { return node_id_; }
+
+  int64_t default_value(const EntryInfo& info, uint8_t axis) const {
+    const int64_t base = info.axis_default != nullptr ? info.axis_default(axis) : info.default_value;
+    return info.default_plus_node_id ? base + node_id_ : base;
+  }
+  // The reference of row `row` for `axis` (axis 0 for device-wide rows).
+  ObjectRef ref(size_t row, uint8_t axis) const {
+    const EntryInfo& info = row_info(row);
+    const uint8_t a = info.axis_stride == 0 ? 0 : axis;
+    return ObjectRef{&info, row, static_cast<uint16_t>(info.index + a * info.axis_stride), a};
+  }
+  uint8_t axes_of(const EntryInfo& info) const { return info.axis_stride == 0 ? 1 : axis_count_; }
+
+ protected:
+  explicit RowDictionary(uint8_t axis_count) : axis_count_(axis_count) {}
+  ~RowDictionary() = default;
+
+ private:
+  uint8_t axis_count_;
+  uint8_t node_id_ = 1;
+};
+
 // Little-endian codec of numeric values: two's complement, sign-extended when read back.
 void encode_value(DataType type, int64_t value, uint8_t* out);
 int64_t decode_value(DataType type, const uint8_t* data);
@@ -168,7 +206,7 @@ constexpr EntryBinding<Owner> field_binding() {
 
 // The dictionary over a module's row table.
 template <class Owner>
-class TableDictionary final : public ObjectDictionary {
+class TableDictionary final : public RowDictionary {
  public:
   // Rows the lookup index holds, and distinct axis strides it handles. A table beyond either is
   // searched row by row: the same answers, only slower (indexed() says which).
@@ -176,22 +214,15 @@ class TableDictionary final : public ObjectDictionary {
   static constexpr size_t kMaxStrides = 4;
 
   TableDictionary(Owner& owner, std::span<const EntryRow<Owner>> rows, uint8_t axis_count)
-      : owner_(owner), rows_(rows), axis_count_(axis_count) {
+      : RowDictionary(axis_count), owner_(owner), rows_(rows) {
     build_index();
   }
   TableDictionary(const TableDictionary&) = delete;
   TableDictionary& operator=(const TableDictionary&) = delete;
 
   std::span<const EntryRow<Owner>> rows() const { return rows_; }
-  uint8_t axis_count() const { return axis_count_; }
-  // The node ID that "$NODEID+" defaults add.
-  void set_node_id(uint8_t node_id) { node_id_ = node_id; }
-  uint8_t node_id() const { return node_id_; }
-
-  int64_t default_value(const EntryInfo& info, uint8_t axis) const {
-    const int64_t base = info.axis_default != nullptr ? info.axis_default(axis) : info.default_value;
-    return info.default_plus_node_id ? base + node_id_ : base;
-  }
+  size_t row_count() const override { return rows_.size(); }
+  const EntryInfo& row_info(size_t row) const override { return rows_[row].info; }
 
   // The first row in table order that is `index`/`sub` for some axis. By binary search over the
   // rows sorted by base index: an object of axis n has its row n strides below `index`, so the
@@ -202,7 +233,7 @@ class TableDictionary final : public ObjectDictionary {
     Match match;
     match_base(index, index, sub, match);
     for (size_t s = 0; s < stride_count_; ++s) {
-      for (uint32_t n = 1; n < axis_count_; ++n) {
+      for (uint32_t n = 1; n < axis_count(); ++n) {
         const uint32_t below = n * strides_[s];
         if (below <= index) match_base(static_cast<uint16_t>(index - below), index, sub, match);
       }
@@ -217,7 +248,7 @@ class TableDictionary final : public ObjectDictionary {
     bool index_found = false;
     for (size_t i = 0; i < rows_.size(); ++i) {
       uint8_t axis = 0;
-      if (!index_matches(rows_[i].info, index, axis_count_, axis)) continue;
+      if (!index_matches(rows_[i].info, index, axis_count(), axis)) continue;
       index_found = true;
       if (rows_[i].info.sub != sub) continue;
       out = ObjectRef{&rows_[i].info, i, index, axis};
@@ -266,23 +297,14 @@ class TableDictionary final : public ObjectDictionary {
     return binding.set(owner_, ref.axis, new_value);
   }
 
-  // The current value of a numeric entry, whatever its access.
-  int64_t value(const ObjectRef& ref) {
+  int64_t value(const ObjectRef& ref) override {
     const auto& binding = rows_[ref.row].binding;
     return binding.get ? binding.get(owner_, ref.axis) : default_value(*ref.info, ref.axis);
   }
-  // Stores without the SDO checks: defaults and stored values at reset.
-  void store(const ObjectRef& ref, int64_t new_value) {
+  void store(const ObjectRef& ref, int64_t new_value) override {
     const auto& binding = rows_[ref.row].binding;
     if (binding.set != nullptr) binding.set(owner_, ref.axis, new_value);
   }
-  // The reference of row `row` for `axis` (axis 0 for device-wide rows).
-  ObjectRef ref(size_t row, uint8_t axis) const {
-    const EntryInfo& info = rows_[row].info;
-    const uint8_t a = info.axis_stride == 0 ? 0 : axis;
-    return ObjectRef{&info, row, static_cast<uint16_t>(info.index + a * info.axis_stride), a};
-  }
-  uint8_t axes_of(const EntryInfo& info) const { return info.axis_stride == 0 ? 1 : axis_count_; }
 
  private:
   static constexpr size_t kNoRow = ~size_t{0};
@@ -337,7 +359,7 @@ class TableDictionary final : public ObjectDictionary {
     for (size_t k = low; k < rows_.size() && rows_[order_[k]].info.index == base; ++k) {
       const size_t row = order_[k];
       uint8_t axis = 0;
-      if (!index_matches(rows_[row].info, index, axis_count_, axis)) continue;
+      if (!index_matches(rows_[row].info, index, axis_count(), axis)) continue;
       match.index_found = true;
       if (rows_[row].info.sub == sub && row < match.row) {
         match.row = row;
@@ -348,8 +370,6 @@ class TableDictionary final : public ObjectDictionary {
 
   Owner& owner_;
   std::span<const EntryRow<Owner>> rows_;
-  uint8_t axis_count_;
-  uint8_t node_id_ = 1;
   // The lookup index, built by the constructor (no heap): row numbers sorted by base index and
   // the table's distinct non-zero axis strides.
   uint16_t order_[kIndexCapacity] = {};

@@ -1,5 +1,7 @@
 #include "core/canopen/pdo.h"
 
+#include "core/canopen/cob_id.h"
+
 namespace motwin::canopen {
 namespace {
 
@@ -7,7 +9,72 @@ uint16_t mapped_index(uint32_t entry) { return static_cast<uint16_t>(entry >> 16
 uint8_t mapped_sub(uint32_t entry) { return static_cast<uint8_t>(entry >> 8); }
 uint8_t mapped_bits(uint32_t entry) { return static_cast<uint8_t>(entry); }
 
+constexpr uint32_t kCobIdExtended = 0x2000'0000;  // bit 29: 29-bit identifier
+constexpr uint32_t kCobIdMask = 0x7FF;
+
 }  // namespace
+
+SdoAbort check_pdo_cob_id(uint32_t current, int64_t value) {
+  const uint32_t v = static_cast<uint32_t>(value);
+  if ((v & kCobIdExtended) != 0 || (v & 0x1FFF'F800) != 0) return SdoAbort::kInvalidValue;
+  const bool valid_now = (current & kPdoCobIdInvalid) == 0;
+  const bool valid_next = (v & kPdoCobIdInvalid) == 0;
+  if (!valid_next) return SdoAbort::kNone;
+  if (restricted_can_id(v & kCobIdMask)) return SdoAbort::kInvalidValue;
+  if (valid_now && ((v ^ current) & kCobIdMask) != 0) return SdoAbort::kInvalidValue;
+  return SdoAbort::kNone;
+}
+
+SdoAbort check_pdo_transmission_type(int64_t value) {
+  return (value >= 1 && value <= kPdoMaxSynchronousType) || value == kPdoEventDrivenManufacturer ||
+                 value == kPdoEventDrivenProfile
+             ? SdoAbort::kNone
+             : SdoAbort::kInvalidValue;
+}
+
+SdoAbort check_pdo_inhibit_time(const PdoCommunication& pdo) {
+  return pdo_valid(pdo) ? SdoAbort::kInvalidValue : SdoAbort::kNone;
+}
+
+SdoAbort check_pdo_mapping_entry(ObjectDictionary& dictionary, bool receive, uint32_t entry, bool dummies_allowed) {
+  const uint16_t index = mapped_index(entry);
+  const uint8_t bits = mapped_bits(entry);
+  if (bits == 0 || bits % 8 != 0) return SdoAbort::kNotMappable;
+  // Both directions may map the dummy types: an RPDO skips their bytes, a TPDO sends zeros.
+  if (is_dummy_mapping(entry)) {
+    if (!dummies_allowed) return SdoAbort::kNotMappable;
+    return type_size(static_cast<DataType>(index)) * 8 == bits ? SdoAbort::kNone : SdoAbort::kNotMappable;
+  }
+  ObjectRef ref;
+  if (dictionary.find(index, mapped_sub(entry), ref) != SdoAbort::kNone) return SdoAbort::kNotMappable;
+  const EntryInfo& info = *ref.info;
+  if (!info.pdo_mappable || type_size(info.type) * 8 != bits) return SdoAbort::kNotMappable;
+  if (receive ? !writable(info.access) : !readable(info.access)) return SdoAbort::kNotMappable;
+  return SdoAbort::kNone;
+}
+
+SdoAbort check_pdo_mapping_count(ObjectDictionary& dictionary, bool receive, const PdoCommunication& pdo,
+                                 const PdoMapping& mapping, int64_t count, bool dummies_allowed) {
+  if (pdo_valid(pdo)) return SdoAbort::kDeviceState;
+  uint32_t bits = 0;
+  for (int64_t i = 0; i < count; ++i) {
+    const uint32_t entry = mapping.entries[i];
+    if (entry == 0) return SdoAbort::kNotMappable;
+    if (const SdoAbort abort = check_pdo_mapping_entry(dictionary, receive, entry, dummies_allowed);
+        abort != SdoAbort::kNone) {
+      return abort;
+    }
+    bits += mapped_bits(entry);
+  }
+  return bits > 64 ? SdoAbort::kMappingTooLong : SdoAbort::kNone;
+}
+
+SdoAbort check_pdo_mapping_write(ObjectDictionary& dictionary, bool receive, const PdoCommunication& pdo,
+                                 const PdoMapping& mapping, int64_t value, bool dummies_allowed) {
+  if (pdo_valid(pdo) || mapping.count != 0) return SdoAbort::kDeviceState;
+  if (value == 0) return SdoAbort::kNone;
+  return check_pdo_mapping_entry(dictionary, receive, static_cast<uint32_t>(value), dummies_allowed);
+}
 
 PdoService::PdoService(ObjectDictionary& dictionary, board::CanController& can,
                        std::span<const PdoCommunication> rpdo, std::span<const PdoMapping> rpdo_mapping,

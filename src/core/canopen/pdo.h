@@ -28,6 +28,7 @@
 
 #include "board/can_controller.h"
 #include "core/canopen/object_dictionary.h"
+#include "core/canopen/sdo_abort.h"
 #include "types/can_frame.h"
 
 namespace motwin::canopen {
@@ -63,6 +64,27 @@ constexpr bool is_dummy_mapping(uint32_t entry) {
   const uint16_t index = static_cast<uint16_t>(entry >> 16);
   return index >= 0x0002 && index <= 0x0007 && ((entry >> 8) & 0xFF) == 0;
 }
+
+// The checks of SDO writes to the PDO parameters (CiA-301 7.5.2.35..38, the rules the
+// TMCM-3216 manual relies on); communication_objects.h binds them to the rows.
+// A COB-ID: 11-bit only, no restricted ID, and its ID does not change while it is valid (set bit
+// 31 first, as python-canopen does). Bit 30 (RTR) is accepted either way: RTR is never answered.
+SdoAbort check_pdo_cob_id(uint32_t current, int64_t value);
+// FF or FE (event driven) or 1..240 (synchronous); other values are not supported.
+SdoAbort check_pdo_transmission_type(int64_t value);
+// Inhibit time: not changeable while the PDO is valid.
+SdoAbort check_pdo_inhibit_time(const PdoCommunication& pdo);
+// A mapping entry `index << 16 | sub << 8 | bits`: the object exists, may be mapped in this
+// direction, and its size is `bits`; the dummy types 0002..0007 (sub 0) where `dummies_allowed`.
+SdoAbort check_pdo_mapping_entry(ObjectDictionary& dictionary, bool receive, uint32_t entry,
+                                 bool dummies_allowed = true);
+// Sub 0 of a mapping: only while the PDO is not valid; entries 1..count must be valid and fit in
+// 8 bytes.
+SdoAbort check_pdo_mapping_count(ObjectDictionary& dictionary, bool receive, const PdoCommunication& pdo,
+                                 const PdoMapping& mapping, int64_t count, bool dummies_allowed = true);
+// An entry: only while the PDO is not valid and sub 0 is 0.
+SdoAbort check_pdo_mapping_write(ObjectDictionary& dictionary, bool receive, const PdoCommunication& pdo,
+                                 const PdoMapping& mapping, int64_t value, bool dummies_allowed = true);
 
 // What a received frame meant to the RPDOs.
 enum class RpdoReception : uint8_t {

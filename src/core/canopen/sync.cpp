@@ -1,6 +1,18 @@
 #include "core/canopen/sync.h"
 
+#include "core/canopen/cob_id.h"
+
 namespace motwin::canopen {
+
+SdoAbort check_sync_cob_id(uint32_t current, int64_t value) {
+  const uint32_t v = static_cast<uint32_t>(value);
+  const uint32_t allowed = kSyncCobIdMask | kSyncProducerBit;
+  if ((v & ~allowed) != 0) return SdoAbort::kInvalidValue;
+  if (restricted_can_id(v & kSyncCobIdMask)) return SdoAbort::kInvalidValue;
+  constexpr uint32_t kIdentifierBits = 0x3FFF'FFFF;
+  if ((current & kSyncProducerBit) != 0 && ((v ^ current) & kIdentifierBits) != 0) return SdoAbort::kInvalidValue;
+  return SdoAbort::kNone;
+}
 
 void SyncService::set_cob_id(uint32_t cob_id) {
   const bool was_producer = producer();

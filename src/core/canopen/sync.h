@@ -10,12 +10,19 @@
 #include <cstdint>
 
 #include "board/can_controller.h"
+#include "core/canopen/sdo_abort.h"
 #include "types/can_frame.h"
 
 namespace motwin::canopen {
 
 inline constexpr uint32_t kSyncProducerBit = 0x4000'0000;  // 1005 bit 30
 inline constexpr uint32_t kSyncCobIdMask = 0x7FF;
+
+// An SDO write of 1005 (`current` is its value now): 11-bit identifiers only (bit 29 refused),
+// bit 30 makes the node the producer; the restricted identifiers the PDO and EMCY COB-IDs refuse
+// too (CiA-301 7.3.5); bits 29..0 do not change while the node produces SYNC (CiA-301 7.5.2.5:
+// a master clears bit 30 first, same identifier, then writes the new one).
+SdoAbort check_sync_cob_id(uint32_t current, int64_t value);
 
 class SyncService {
  public:

@@ -1,10 +1,10 @@
-// The TMCM-3216 with its CANopen firmware V1.04: the communication area of the object dictionary
-// (manual chapter 3), the node ID and bit rate objects 2704..2708 (4.2.62..4.2.66), NMT with
-// boot-up and heartbeat, the SDO server, and store/restore through the board's non-volatile
-// memory, the EMCY producer and the heartbeat consumer with the 1029 error behaviour, RPDOs and
-// TPDOs with the manual's numbering and defaults, SYNC (consumer; producer as a Motwin extension)
-// and the LSS slave; and the three-axis CiA-402 drive (Tmcm3216Drive per axis) on the
-// stepper axes of its board (Tmcm3216Stepper, board/modules/tmcm3216/tmcm3216_board.h). docs/tmcm-3216-drive.md.
+// The TMCM-3216 with its CANopen firmware V1.04: a CANopen node (core/canopen/node.h: NMT with
+// boot-up and heartbeat, SDO, PDO, SYNC, EMCY, heartbeat consumer, LSS, storage) with the
+// manual's identity, communication objects (chapter 3, tmcm3216_objects.cpp), PDO numbering and
+// defaults, node ID and bit rate objects 2704..2708 (4.2.62..4.2.66) and restart timing; and the
+// application behind it: the three-axis CiA-402 drive (Tmcm3216Drive per axis) on the stepper
+// axes of its board (Tmcm3216Stepper, board/modules/tmcm3216/tmcm3216_board.h) with the
+// emergencies of table 365. docs/tmcm-3216-drive.md.
 #pragma once
 
 #include <array>
@@ -16,17 +16,10 @@
 #include "board/can_controller.h"
 #include "board/non_volatile_memory.h"
 #include "board/modules/tmcm3216/tmcm3216_board.h"
-#include "core/canopen/emergency.h"
+#include "core/canopen/node.h"
+#include "core/canopen/object_dictionary.h"
 #include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "core/modules/tmcm3216/tmcm3216_emergencies.h"
-#include "core/canopen/heartbeat_consumer.h"
-#include "core/canopen/nmt.h"
-#include "core/canopen/lss_slave.h"
-#include "core/canopen/object_dictionary.h"
-#include "core/canopen/pdo.h"
-#include "core/canopen/sdo_server.h"
-#include "core/canopen/storage.h"
-#include "core/canopen/sync.h"
 #include "core/modules/tmcm3216/tmcm3216_io.h"
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
 #include "types/can_frame.h"
@@ -38,51 +31,42 @@ inline constexpr uint8_t kPdosPerAxis = 4;       // RPDO/TPDO 1..4, 65..68, 129.
 inline constexpr uint8_t kMaxMappedObjects = 3;  // "dynamic mapping with max. three mapping entries"
 inline constexpr uint16_t kPdoAxisStride = 0x40; // 1400 -> 1440 -> 1480 (manual 3.1.15)
 inline constexpr size_t kPdoCount = kAxisCount * kPdosPerAxis;  // per direction; PDO K of axis n at n * 4 + K
+static_assert(kPdoCount <= canopen::kNodeMaxPdos);
 // The motion tick (same as the TMCM-142): each tick the sim board senses, tick() runs the drives
 // and steppers, the plants advance kTickUs. The CANopen services keep their millisecond timers:
 // they run once per kServicePeriodUs of ticks (and at once whenever a frame arrives, so that an
 // SDO request is answered within the tick or process() call that sees it).
 inline constexpr uint32_t kTickUs = 50;
-inline constexpr uint32_t kServicePeriodUs = 1000;
+inline constexpr uint32_t kServicePeriodUs = canopen::Node::kServicePeriodUs;
 
 using PdoCommunication = canopen::PdoCommunication;
 using PdoMapping = canopen::PdoMapping;  // entries 1..kMaxMappedObjects used
+// The communication objects a master writes and the stored node ID / bit rate (2704 / 2705) are
+// the node's (core/canopen/node.h).
+using CommunicationConfig = canopen::CommunicationConfig;
+using NodeSettings = canopen::NodeSettings;
+// The module's address switches, its serial number (1018 sub 4) and restart times: the node's
+// config. `motwin serve` uses Tmcm3216::kBootDelayUs and kCommunicationBootDelayUs.
+using Tmcm3216Config = canopen::NodeConfig;
 
-// The communication objects a master writes (1005..1029, 1400..1A03 of each axis).
-struct CommunicationConfig {
-  uint32_t sync_cob_id;              // 1005
-  uint32_t sync_period_us;           // 1006
-  uint32_t emcy_cob_id;              // 1014
-  uint16_t emcy_inhibit_100us;       // 1015
-  uint32_t consumer_heartbeat[1];    // 1016 sub 1
-  uint16_t producer_heartbeat_ms;    // 1017
-  uint8_t error_behavior[2];         // 1029 sub 1, 2
-  PdoCommunication rpdo[kPdoCount];
-  PdoMapping rpdo_mapping[kPdoCount];
-  PdoCommunication tpdo[kPdoCount];
-  PdoMapping tpdo_mapping[kPdoCount];
+// Manual table 177.
+inline constexpr uint16_t kBitRatesKbit[] = {20, 50, 100, 125, 250, 500, 800, 1000};
+
+// 1010 / 1011 (tables 23, 26): sub 1 everything (restore: all but the node ID and bit rate,
+// which would cut the module off its bus), sub 2 the node settings 2704/2705 (restore: "no
+// function", manual 3.1.8), sub 3 device profile parameters "not used", subs 4..6 motor n.
+inline constexpr uint8_t kAllAxesMask = (1u << kAxisCount) - 1;
+inline constexpr canopen::StorageSubIndex kStorageSubIndices[] = {
+    {true, {.communication = true, .node_settings = true, .axis_mask = kAllAxesMask}, true,
+     {.communication = true, .axis_mask = kAllAxesMask}},
+    {true, {.node_settings = true}, true, {}},
+    {false, {}, false, {}},
+    {true, {.axis_mask = 1}, true, {.axis_mask = 1}},
+    {true, {.axis_mask = 2}, true, {.axis_mask = 2}},
+    {true, {.axis_mask = 4}, true, {.axis_mask = 4}},
 };
 
-// 2704 / 2705: what applies after the next reset (2707 / 2708 show what applies now).
-struct NodeSettings {
-  uint16_t bit_rate_kbit;
-  uint8_t node_id;  // 1..127, 255 = LSS unconfigured
-};
-
-struct Tmcm3216Config {
-  // The module's address switches: 1..127 overrides the stored node ID (2705), as the manual
-  // says switches do (4.2.63); 0 = no switches, 2705 decides.
-  uint8_t node_id_switches = 0;
-  uint32_t serial_number = 0;  // 1018 sub 4
-  // Restart times in simulated µs: from power-up or NMT reset node, and from NMT reset
-  // communication (also the one an LSS switch to waiting makes), to the boot-up message. The node
-  // hears and sends nothing meanwhile. 0 boots at once (the protocol tests); `motwin serve` uses
-  // Tmcm3216::kBootDelayUs and kCommunicationBootDelayUs (docs/canopen.md "Start-up timing").
-  uint32_t boot_delay_us = 0;
-  uint32_t communication_boot_delay_us = 0;
-};
-
-class Tmcm3216 final : private canopen::LssDevice {
+class Tmcm3216 final : private canopen::NodeApplication {
  public:
   using Dictionary = canopen::TableDictionary<Tmcm3216>;
   using Row = canopen::EntryRow<Tmcm3216>;
@@ -98,13 +82,13 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr uint32_t kVendorId = 0x0000'0286;
   static constexpr uint32_t kProductCode = 3216;
   static constexpr uint32_t kRevisionNumber = 0x0001'0004;  // major << 16 | minor, "20003h for 2.3"
-  static constexpr uint32_t kSaveSignature = 0x6576'6173;   // "save"
-  static constexpr uint32_t kLoadSignature = 0x6461'6F6C;   // "load"
+  static constexpr uint32_t kSaveSignature = canopen::kSaveSignature;
+  static constexpr uint32_t kLoadSignature = canopen::kLoadSignature;
 
   static constexpr uint32_t kNvmLayoutVersion = 1;
   static constexpr size_t kNvmRecordCapacity = 1024;
   static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
-  static constexpr size_t kReceiveQueueLength = 32;
+  static constexpr size_t kReceiveQueueLength = canopen::Node::kReceiveQueueLength;
   // The restart times `motwin serve` gives the module unless told otherwise (Tmcm3216Config).
   // The manual gives none: a Motwin decision (docs/canopen.md "Start-up timing"). A reset node
   // restarts the processor like a power-up (bootloader, three driver chips and the stored
@@ -112,6 +96,16 @@ class Tmcm3216 final : private canopen::LssDevice {
   static constexpr uint32_t kBootDelayUs = 300'000;
   static constexpr uint32_t kCommunicationBootDelayUs = 50'000;
 
+  // What the node knows of the firmware: identity, PDOs, bit rates, storage.
+  static constexpr canopen::NodeDescription kNode{
+      .identity = {kVendorId, kProductCode, kRevisionNumber},
+      .pdo_count = kPdoCount,
+      .bit_rates_kbit = kBitRatesKbit,
+      .storage = kStorageSubIndices,
+      .rpdo_value_emcy = kEmcyPdoParameter,
+      // Manual table 365: byte 2 is the motor, 255 for the communication errors.
+      .communication_emcy_data = {0, 255, 0, 0, 0},
+  };
   // Every object of the dictionary (tmcm3216_objects.cpp).
   static std::span<const Row> object_table();
   // An image with nothing stored: every object at its default.
@@ -126,36 +120,41 @@ class Tmcm3216 final : private canopen::LssDevice {
 
   // Power-on: every object from the NVM (or its default); after the boot delay the boot-up
   // message and pre-operational.
-  void power_up();
+  void power_up() {
+    axes_touched_ = true;
+    node_.power_up();
+  }
   // A frame from the bus (the CAN receive interrupt): queued for the next process() call.
   // false: the queue was full and the frame is lost.
-  bool receive(const can::CanFrame& frame);
+  bool receive(const can::CanFrame& frame) { return node_.receive(frame); }
   // Handles the queued frames, then advances the services' timers by `elapsed_us`.
-  void process(uint32_t elapsed_us);
+  void process(uint32_t elapsed_us) {
+    axes_touched_ = true;  // whatever the services do to the axes, their next tick is a full one
+    node_.process(elapsed_us);
+  }
   // One motion tick: queued frames, the services once per kServicePeriodUs, then every axis
   // (drive, stepper) and the I/O against the board.
   void tick();
 
-  uint8_t node_id() const { return node_id_; }            // active (2708)
-  uint16_t bit_rate_kbit() const { return bit_rate_kbit_; }  // active (2707)
-  bool configured() const { return node_id_ >= 1 && node_id_ <= 127; }
+  // The CANopen node (CiA-301 services, communication objects).
+  canopen::Node& node() { return node_; }
+  uint8_t node_id() const { return node_.node_id(); }              // active (2708)
+  uint16_t bit_rate_kbit() const { return node_.bit_rate_kbit(); }  // active (2707)
+  bool configured() const { return node_.configured(); }
   // Between a power-up or NMT reset and the boot-up (Tmcm3216Config's delays): frames received
   // are dropped, nothing is sent.
-  bool restarting() const { return restarting_; }
-  canopen::NmtState nmt_state() const { return nmt_.state(); }
+  bool restarting() const { return node_.restarting(); }
+  canopen::NmtState nmt_state() const { return node_.nmt_state(); }
   // 1001: communication bits, the FAULT bits of the axes, the active conditions of table 365.
-  uint8_t error_register() const {
-    const uint8_t parameter = parameter_error_ ? canopen::kErrorRegisterGeneric : 0;
-    return static_cast<uint8_t>(error_register_ | parameter | axis_error_register() | emergencies_.error_register());
-  }
-  uint64_t dropped_frames() const { return dropped_frames_; }
+  uint8_t error_register() const { return node_.error_register(); }
+  uint64_t dropped_frames() const { return node_.dropped_frames(); }
   // Communication errors now active (kCommError* bits); 1001 bit 4 while any is.
-  uint8_t communication_errors() const { return communication_errors_; }
-  static constexpr uint8_t kCommErrorHeartbeat = 0x01;
-  static constexpr uint8_t kCommErrorCanOverrun = 0x02;
-  static constexpr uint8_t kCommErrorPdoLength = 0x04;
-  static constexpr uint8_t kCommErrorPdoLengthExceeded = 0x08;
-  static constexpr uint8_t kCommErrorCanController = 0x10;  // error-passive, bus-off, just recovered
+  uint8_t communication_errors() const { return node_.communication_errors(); }
+  static constexpr uint8_t kCommErrorHeartbeat = canopen::Node::kCommErrorHeartbeat;
+  static constexpr uint8_t kCommErrorCanOverrun = canopen::Node::kCommErrorCanOverrun;
+  static constexpr uint8_t kCommErrorPdoLength = canopen::Node::kCommErrorPdoLength;
+  static constexpr uint8_t kCommErrorPdoLengthExceeded = canopen::Node::kCommErrorPdoLengthExceeded;
+  static constexpr uint8_t kCommErrorCanController = canopen::Node::kCommErrorCanController;
 
   // The accessors that let a caller change the axes' objects or state directly wake the resting
   // axes (run_axes()) as a frame does.
@@ -163,16 +162,16 @@ class Tmcm3216 final : private canopen::LssDevice {
     axes_touched_ = true;
     return dictionary_;
   }
-  canopen::NmtSlave& nmt() { return nmt_; }
-  canopen::SdoServer& sdo() { return sdo_; }
-  canopen::EmergencyProducer& emergency() { return emergency_; }
-  canopen::HeartbeatConsumer& heartbeat_consumer() { return heartbeat_consumer_; }
-  canopen::PdoService& pdos() { return pdos_; }
-  canopen::SyncService& sync() { return sync_; }
-  canopen::LssSlave& lss() { return lss_; }
-  CommunicationConfig& communication() { return communication_; }
-  NodeSettings& node_settings() { return node_settings_; }
-  const Tmcm3216Config& config() const { return config_; }
+  canopen::NmtSlave& nmt() { return node_.nmt(); }
+  canopen::SdoServer& sdo() { return node_.sdo(); }
+  canopen::EmergencyProducer& emergency() { return node_.emergency(); }
+  canopen::HeartbeatConsumer& heartbeat_consumer() { return node_.heartbeat_consumer(); }
+  canopen::PdoService& pdos() { return node_.pdos(); }
+  canopen::SyncService& sync() { return node_.sync(); }
+  canopen::LssSlave& lss() { return node_.lss(); }
+  CommunicationConfig& communication() { return node_.communication(); }
+  NodeSettings& node_settings() { return node_.node_settings(); }
+  const Tmcm3216Config& config() const { return node_.config(); }
   Tmcm3216Drive& drive(uint8_t axis) {
     axes_touched_ = true;
     return drives_[axis];
@@ -196,72 +195,36 @@ class Tmcm3216 final : private canopen::LssDevice {
   board::Tmcm3216Board& board() { return board_; }
 
   // 1010 / 1011 / 2706 sub-index `sub` written with `signature`.
-  canopen::SdoAbort store_parameters(uint8_t sub, uint32_t signature);
-  canopen::SdoAbort restore_parameters(uint8_t sub, uint32_t signature);
-  canopen::SdoAbort store_node_settings(uint32_t signature);
+  canopen::SdoAbort store_parameters(uint8_t sub, uint32_t signature) { return node_.store_parameters(sub, signature); }
+  canopen::SdoAbort restore_parameters(uint8_t sub, uint32_t signature) {
+    return node_.restore_parameters(sub, signature);
+  }
+  canopen::SdoAbort store_node_settings(uint32_t signature) { return node_.store_node_settings(signature); }
 
  private:
-  // NMT reset node (and power-up): the application objects (manufacturer and profile areas) to
-  // their power-on values, or the stored ones, then the communication reset.
-  void reset_node();
-  // Every object of 2000h..9FFFh as power-on builds it: the objects' structs value-initialised,
-  // the stored values loaded on top, the axes' live state reset.
-  void reset_application();
+  // canopen::NodeApplication. NMT reset node (and power-up): every object of 2000h..9FFFh as
+  // power-on builds it: the objects' structs value-initialised, the stored values loaded on top,
+  // the axes' live state reset.
+  void reset_application() override;
+  // A SYNC seen or produced: csp/csv set-points of every axis (after the synchronous RPDOs).
+  void on_sync() override;
+  // Table 365, 8140: at bus-off "the drive has been stopped and disabled".
+  void on_bus_off() override;
+  // The FAULT bits of the axes and the active conditions of table 365.
+  uint8_t application_error_register() const override {
+    return static_cast<uint8_t>(axis_error_register() | emergencies_.error_register());
+  }
+
   void reset_axes();
   void run_axes(uint32_t dt_us);
   // run_axis(), and whether it changed nothing but what rest() changes (the axis then rests).
   void run_axis_checking_rest(uint8_t axis, uint32_t dt_us);
   void run_axis(uint8_t axis, uint32_t dt_us);
-  // A SYNC seen or produced: csp/csv set-points of every axis (after the synchronous RPDOs).
-  void sync_axes();
   // 1001 bits of the axes: generic + device profile while an axis is in FAULT (or reacting).
   uint8_t axis_error_register() const;
-  // NMT reset communication: the objects 1000h..1FFFh to their stored values or defaults, the
-  // node ID and bit rate as stored (2704/2705 themselves untouched), the services reset; the
-  // boot-up follows after `boot_delay_us`.
-  void reset_communication();
-  void reset_communication(uint32_t boot_delay_us);
-  // The restart ends: boot-up (when configured), pre-operational.
-  void finish_restart();
-  void handle_frame(const can::CanFrame& frame);
-  void run_nmt(uint32_t elapsed_us);
-  void run_heartbeat_consumer(uint32_t elapsed_us);
-  void run_sync(uint32_t elapsed_us);
-  void handle_pdo(const can::CanFrame& frame);
-  // EMCY 6320 when RPDO writes since the last check had a value refused; 0000 when the next
-  // RPDO is written whole.
-  void check_rpdo_values();
-  void check_receive_overrun(uint32_t elapsed_us);
-  // The CAN controller's fault confinement (board::CanController::status()), once per service
-  // tick: EMCY 8120 while error-passive, the running axes stopped at bus-off, 8140 once back.
-  void check_can_controller();
-  // Sets / clears one kCommError* bit, with its EMCY (code, or 0000 when it clears).
-  void raise_error(uint8_t error, uint16_t emcy_code);
-  void clear_error(uint8_t error);
-  // Sets a kCommError* bit and sends `emcy_code` even if the bit was set already.
-  void report_error(uint8_t error, uint16_t emcy_code);
-  canopen::LssIdentity identity() const;
-  // canopen::LssDevice.
-  bool lss_bit_rate_supported(uint16_t bit_rate_kbit) const override;
-  bool lss_store(uint8_t node_id, uint16_t bit_rate_kbit) override;
 
-  board::NonVolatileMemory& nvm_;
-  board::CanController& can_;
   board::Tmcm3216Board own_board_{};  // used by the constructor without a board
   board::Tmcm3216Board& board_;
-  Tmcm3216Config config_;
-  CommunicationConfig communication_{};
-  NodeSettings node_settings_{};
-  uint8_t node_id_ = 1;
-  uint16_t bit_rate_kbit_ = 1000;
-  uint16_t lss_bit_rate_kbit_ = 0;  // activated by LSS since power-up (0: none)
-  uint8_t error_register_ = 0;
-  uint64_t reported_refused_writes_ = 0;
-  uint64_t reported_rpdo_writes_ = 0;
-  bool parameter_error_ = false;  // EMCY 6320 sent, not yet cleared
-  uint32_t service_elapsed_us_ = 0;
-  bool restarting_ = false;
-  uint32_t restart_remaining_us_ = 0;
 
   std::array<Tmcm3216Stepper, kAxisCount> steppers_{};
   std::array<Tmcm3216Drive, kAxisCount> drives_{};
@@ -283,26 +246,8 @@ class Tmcm3216 final : private canopen::LssDevice {
   Tmcm3216Emergencies rest_check_emergencies_{};
 
   Dictionary dictionary_;
-  canopen::NmtSlave nmt_;
-  canopen::SdoServer sdo_;
-  canopen::EmergencyProducer emergency_;
-  canopen::HeartbeatConsumer heartbeat_consumer_;
-  canopen::SyncService sync_;
-  canopen::PdoService pdos_;
-  canopen::LssSlave lss_;
-  uint8_t communication_errors_ = 0;
-  // What kCommErrorCanController stands for now (the last state reported).
-  enum class CanControllerError : uint8_t { kNone, kErrorPassive, kBusOff, kRecovered };
-  CanControllerError can_controller_error_ = CanControllerError::kNone;
-  uint32_t bus_off_recoveries_ = 0;  // board::CanControllerStatus::bus_off_recoveries seen
   std::array<uint8_t, kNvmSize> storage_scratch_{};
-  canopen::ObjectStorage<Tmcm3216> storage_;
-
-  std::array<can::CanFrame, kReceiveQueueLength> receive_queue_{};
-  size_t receive_head_ = 0;
-  size_t receive_count_ = 0;
-  uint64_t dropped_frames_ = 0;
-  uint64_t reported_dropped_frames_ = 0;
+  canopen::Node node_;
 };
 
 }  // namespace motwin::modules::tmcm3216
