@@ -1,17 +1,23 @@
 // One CiA-402 axis: the PDS state machine (power_drive_system.h), the modes of operation and
-// their dispatch (pp, pv, hm, csp, csv; 6060/6061), the EightPoint ramp that produces the
-// position demand (6062), the monitoring functions (position window, following error, software
-// limits, limit switches, stall, power-stage faults) and the statusword. It is pure arithmetic:
-// the module hands in what the axis hardware saw this tick (AxisInputs) and passes the demand on
-// to its stepper (AxisDemand); drive events (fault reset, following error, stall, limits) are
-// queued as emergencies for the module to read.
+// their dispatch (pp, pv, hm, csp, csv, cst; 6060/6061), the profile generator that produces the
+// position demand (6062: the EightPoint ramp, in its trapezoid form 6081/6083/6084 unless the
+// module shapes it further), the monitoring functions (position window, following error,
+// software limits, limit switches, stall, power-stage faults) and the statusword. It is pure
+// arithmetic and does not know what executes the demand: the module hands in what the axis
+// hardware saw this tick (AxisInputs) and passes the demand (AxisDemand: a position with its
+// velocity, a velocity, or a torque, and the power stage's state) on to its axis, a stepper or a
+// servo cascade; drive events (fault reset, following error, stall, limits) are queued as
+// emergencies for the module to read.
 //
 // Edges of the controlword (pp new set-point, hm start, fault reset) act when the controlword
 // is written, so that a statusword read right after the write already shows the
 // acknowledgement (python-canopen and ros2_canopen poll at once, docs/tmcm-3216-drive.md).
 //
-// Internal units: microsteps, microsteps/s (pps), microsteps/s² (pps2); objects are converted
-// with the module's UnitScale. docs/tmcm-3216-drive.md describes the behaviour in detail.
+// Internal units: increments of the axis' position counter (`usteps`: microsteps on the TMCM-3216,
+// position units of 2058 on the TMCM-1636), increments/s (pps), increments/s² (pps2); velocity and
+// acceleration objects are converted with the module's UnitScale, torques are in the module's own
+// unit. docs/tmcm-3216-drive.md describes the behaviour in detail, docs/tmcm-1636-canopen.md the
+// servo's differences.
 //
 // The module's part (a compile-time seam, as moteus plugs its board into the controller):
 // AxisDrive<Manufacturer> keeps one `Manufacturer` per axis (`manufacturer`: the module's
@@ -25,7 +31,17 @@
 //   static AxisEmergency emergency(DriveEvent event)
 //       the EMCY code and additional byte the module reports a drive event with;
 //   static uint16_t manufacturer_status_bits(bool motor_active, bool negative_direction)
-//       the manufacturer-specific statusword bits (8, 14, 15).
+//       the manufacturer-specific statusword bits (8, 14, 15);
+//   static constexpr uint32_t kSupportedModes
+//       the modes 6060 accepts, as 6502 bits (drive_mode_bit());
+//   static bool supports_homing_method(int8_t method)
+//       the methods 6098 accepts (a subset of Homing's);
+//   static constexpr bool kServo
+//       false: a stepper follows the demand open loop (the ramp is the motion; 606C is the ramp's
+//       velocity); true: a closed loop follows it and the actual motion is measured (606C is the
+//       measured velocity, AxisInputs::actual_velocity_pps), so the profile generator restarts from
+//       the measured motion whenever the motion is handed over (a mode change, the power stage off,
+//       leaving cst).
 // The member definitions are in axis_drive_impl.h, compiled once per module where the module
 // instantiates its drive (the TMCM-3216: src/core/modules/tmcm3216/tmcm3216_drive.{h,cpp}).
 #pragma once
@@ -66,11 +82,15 @@ concept ManufacturerPart = requires(const M& part, motion::EightPointConfig& pro
   part.shape_profile(profile, units);
   { M::emergency(event) } -> std::same_as<AxisEmergency>;
   { M::manufacturer_status_bits(flag, flag) } -> std::same_as<uint16_t>;
+  { M::kSupportedModes } -> std::convertible_to<uint32_t>;
+  { M::supports_homing_method(int8_t{0}) } -> std::same_as<bool>;
+  { M::kServo } -> std::convertible_to<bool>;
 };
 
 // What the axis hardware shows this tick.
 struct AxisInputs {
   int32_t encoder_position_usteps = 0;  // scaled to microsteps (608F); used when 606A = 0
+  double actual_velocity_pps = 0.0;     // the measured velocity (a servo's; a stepper's is ignored)
   bool left_limit = false;              // processed levels (the module applied disable/invert)
   bool right_limit = false;
   bool home_switch = false;
@@ -86,10 +106,17 @@ struct AxisInputs {
   bool ready = true;
 };
 
-// What the axis asks of the stepper this tick.
+// What the axis follows this tick: the position (with the velocity as its feed-forward), the
+// velocity, or the torque.
+enum class DriveControl : uint8_t { kPosition, kVelocity, kTorque };
+
+// What the axis asks of the stepper (or servo) this tick.
 struct AxisDemand {
+  DriveControl control = DriveControl::kPosition;
   int32_t position_usteps = 0;
   int32_t velocity_pps = 0;
+  double velocity_exact_pps = 0.0;  // velocity_pps unrounded (a servo's feed-forward)
+  int32_t torque = 0;               // 6074, in the module's torque unit (control kTorque)
   bool power_enabled = false;
   bool brake_released_request = false;
   bool switch_on_disabled = true;
@@ -101,7 +128,8 @@ class AxisDrive {
   static_assert(ManufacturerPart<Manufacturer>, "see \"The module's part\" above");
 
  public:
-  // csp/csv: a set-point written without a SYNC for this long is taken at once.
+  using Part = Manufacturer;
+  // csp/csv/cst: a set-point written without a SYNC for this long is taken at once.
   static constexpr uint32_t kSyncAbsentUs = 100'000;
 
   ProfileObjects objects;
@@ -118,6 +146,8 @@ class AxisDrive {
   // 607A written in the same instant as the bit 4 edge (one RPDO) is the set-point taken.
   void target_position_written();
   void target_velocity_written();
+  // 6071 written: cst takes it at once when no SYNC drives it.
+  void target_torque_written();
   // A SYNC (after the synchronous RPDOs were written): csp/csv take 607A + 60B0 / 60FF + 60B1.
   void on_sync();
   // A fault from outside the axis (NMT stopped while operation enabled, ...).
@@ -145,6 +175,7 @@ class AxisDrive {
   int32_t position_demand() const { return ramp_.position(); }  // 6062
   int32_t position_actual() const;                               // 6063 / 6064
   int32_t velocity_actual_value() const;                         // 606C in object units
+  int32_t velocity_demand_value() const { return units().velocity_value(ramp_.velocity()); }  // 606B
   double velocity_pps() const { return ramp_.velocity(); }
   PdsState state() const { return pds_.state(); }
   const PowerDriveSystem& pds() const { return pds_; }
@@ -177,6 +208,10 @@ class AxisDrive {
   void run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s);
   void run_cyclic_position(double dt_s);
   void run_cyclic_velocity(const AxisInputs& inputs, double dt_s);
+  void run_cyclic_torque();
+  // A servo's profile generator takes the measured motion (Manufacturer::kServo).
+  void follow_actual_motion();
+  int32_t limited_torque(int32_t torque) const;
   void latch_cyclic_set_point();
   // Limit switches and software limits: which directions are blocked now (EMCY FF01 on entry).
   void update_limits(const AxisInputs& inputs);
@@ -222,6 +257,9 @@ class AxisDrive {
   double cyclic_velocity_from_ = 0;
   double cyclic_velocity_to_ = 0;
   double cyclic_elapsed_s_ = 0;
+  int32_t cyclic_torque_ = 0;
+  DriveControl control_ = DriveControl::kPosition;
+  double actual_velocity_pps_ = 0.0;  // the servo's measured velocity of this tick
 
   // Monitoring.
   bool following_error_ = false;

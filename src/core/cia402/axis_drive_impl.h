@@ -4,6 +4,7 @@
 // every other file includes only axis_drive.h.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -47,6 +48,9 @@ void AxisDrive<Manufacturer>::reset(int32_t position) {
   stopping_on_limit_ = false;
   us_since_sync_ = kSyncAbsentUs;
   cyclic_latched_ = false;
+  cyclic_torque_ = 0;
+  control_ = DriveControl::kPosition;
+  actual_velocity_pps_ = 0.0;
   following_error_ = false;
   limit_active_ = false;
   for (bool& reported : limit_reported_) reported = false;
@@ -122,6 +126,8 @@ motion::EightPointConfig AxisDrive<Manufacturer>::profile_config() const {
   c.d1_pps2 = c.dmax_pps2;
   c.d2_pps2 = c.dmax_pps2;
   c.vstop_pps = u.velocity_pps(objects.end_velocity);
+  // 607F bounds the profile velocity (0: no bound).
+  if (objects.max_profile_velocity != 0) c.vmax_pps = std::min(c.vmax_pps, u.velocity_pps(objects.max_profile_velocity));
   manufacturer.shape_profile(c, u);
   return c;
 }
@@ -325,6 +331,13 @@ void AxisDrive<Manufacturer>::target_velocity_written() {
 }
 
 template <class Manufacturer>
+void AxisDrive<Manufacturer>::target_torque_written() {
+  if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncTorque) && us_since_sync_ >= kSyncAbsentUs) {
+    latch_cyclic_set_point();
+  }
+}
+
+template <class Manufacturer>
 void AxisDrive<Manufacturer>::on_sync() {
   us_since_sync_ = 0;
   latch_cyclic_set_point();
@@ -346,6 +359,8 @@ void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
     cyclic_velocity_from_ = ramp_.velocity();
     cyclic_velocity_to_ =
         units().velocity_pps(static_cast<double>(objects.target_velocity) + static_cast<double>(objects.velocity_offset));
+  } else if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncTorque)) {
+    cyclic_torque_ = limited_torque(int32_t{objects.target_torque} + objects.torque_offset);
   } else {
     return;
   }
@@ -356,9 +371,24 @@ void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
 // --- The tick ---------------------------------------------------------------------------------
 
 template <class Manufacturer>
+void AxisDrive<Manufacturer>::follow_actual_motion() {
+  ramp_.set_state(actual_position_, actual_velocity_pps_);
+}
+
+template <class Manufacturer>
+int32_t AxisDrive<Manufacturer>::limited_torque(int32_t torque) const {
+  const int32_t limit = objects.max_torque;
+  if (limit == 0) return torque;
+  return torque > limit ? limit : torque < -limit ? -limit : torque;
+}
+
+template <class Manufacturer>
 void AxisDrive<Manufacturer>::on_mode_change(int8_t from, int8_t to) {
   if (from == static_cast<int8_t>(Mode::kHoming) && homing_.active()) homing_.stop();
+  // A servo's new mode starts from where the motor is and how fast it turns (bumpless).
+  if constexpr (Manufacturer::kServo) follow_actual_motion();
   cyclic_latched_ = false;
+  cyclic_torque_ = 0;
   halted_ = false;
   stall_stop_ = false;
   switch (static_cast<Mode>(to)) {
@@ -392,6 +422,7 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
     active_mode_ = objects.mode;
     on_mode_change(from, active_mode_);
   }
+  actual_velocity_pps_ = inputs.actual_velocity_pps;
   last_encoder_usteps_ = inputs.encoder_position_usteps;
   in.encoder_position_usteps = drive_detail::wrap(static_cast<int64_t>(inputs.encoder_position_usteps) + encoder_offset_);
   actual_position_ = objects.sensor_selection == 0 ? in.encoder_position_usteps : ramp_.position();
@@ -401,7 +432,10 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   if (objects.sensor_selection != 0) actual_position_ = ramp_.position();
   update_target_reached(inputs, dt_us);
 
+  demand_.control = control_;
+  demand_.torque = control_ == DriveControl::kTorque ? cyclic_torque_ : 0;
   demand_.position_usteps = ramp_.position();
+  demand_.velocity_exact_pps = ramp_.velocity();
   demand_.velocity_pps = static_cast<int32_t>(std::lround(ramp_.velocity()));
   demand_.power_enabled = pds_.power_enabled();
   const PdsState state = pds_.state();
@@ -444,10 +478,18 @@ void AxisDrive<Manufacturer>::check_faults(const AxisInputs& inputs) {
 
 template <class Manufacturer>
 void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt_s) {
+  // The velocity modes hand the axis a velocity (also while they stop); the others a position.
+  // cst hands it a torque while it runs (run_cyclic_torque) and a velocity while it stops.
+  const Mode mode = static_cast<Mode>(active_mode_);
+  control_ = mode == Mode::kProfileVelocity || mode == Mode::kCyclicSyncVelocity || mode == Mode::kCyclicSyncTorque
+                 ? DriveControl::kVelocity
+                 : DriveControl::kPosition;
   switch (pds_.motion()) {
     case PdsMotion::kOff:
     case PdsMotion::kHold:
       ramp_.halt();
+      // A servo's motor is not held by the demand meanwhile: the demand stays where it is.
+      if constexpr (Manufacturer::kServo) ramp_.set_position(actual_position_);
       if (homing_.active()) homing_.stop();
       moving_to_target_ = false;
       pending_ = false;
@@ -510,6 +552,7 @@ void AxisDrive<Manufacturer>::run_mode(const AxisInputs& inputs, double dt_s) {
     case Mode::kHoming: run_homing(inputs, static_cast<uint32_t>(std::lround(dt_s * 1e6)), dt_s); break;
     case Mode::kCyclicSyncPosition: run_cyclic_position(dt_s); break;
     case Mode::kCyclicSyncVelocity: run_cyclic_velocity(inputs, dt_s); break;
+    case Mode::kCyclicSyncTorque: run_cyclic_torque(); break;
     case Mode::kNone:
       // "The motor does not run when the operating mode is set to 0" (5.1.6).
       stop_ramp(slow_down_pps2());
@@ -736,6 +779,16 @@ void AxisDrive<Manufacturer>::run_cyclic_velocity(const AxisInputs& inputs, doub
 }
 
 template <class Manufacturer>
+void AxisDrive<Manufacturer>::run_cyclic_torque() {
+  // cst: the torque set-point goes to the axis as it is (6071 + 60B2, bounded by 6072); the
+  // profile generator follows the measured motion, so that a stop or another mode goes on from it.
+  follow_actual_motion();
+  control_ = DriveControl::kTorque;
+  if (!cyclic_latched_) cyclic_torque_ = 0;
+  ramp_config_ = profile_config();
+}
+
+template <class Manufacturer>
 void AxisDrive<Manufacturer>::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_us) {
   const Mode mode = static_cast<Mode>(active_mode_);
   if (halted_) {
@@ -772,7 +825,10 @@ template <class Manufacturer>
 int32_t AxisDrive<Manufacturer>::position_actual() const { return actual_position_; }
 
 template <class Manufacturer>
-int32_t AxisDrive<Manufacturer>::velocity_actual_value() const { return units().velocity_value(ramp_.velocity()); }
+int32_t AxisDrive<Manufacturer>::velocity_actual_value() const {
+  if constexpr (Manufacturer::kServo) return units().velocity_value(actual_velocity_pps_);
+  return units().velocity_value(ramp_.velocity());
+}
 
 template <class Manufacturer>
 uint16_t AxisDrive<Manufacturer>::statusword() const {
@@ -800,6 +856,7 @@ uint16_t AxisDrive<Manufacturer>::statusword() const {
       break;
     case Mode::kCyclicSyncPosition:
     case Mode::kCyclicSyncVelocity:
+    case Mode::kCyclicSyncTorque:
       if (enabled && pds_.motion() == PdsMotion::kRun && !halted_) sw |= kSwOms12;
       break;
     case Mode::kNone: break;

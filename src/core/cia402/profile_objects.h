@@ -19,12 +19,21 @@ enum class Mode : int8_t {
   kHoming = 6,
   kCyclicSyncPosition = 8,
   kCyclicSyncVelocity = 9,
+  kCyclicSyncTorque = 10,
 };
-constexpr bool supported_mode(int64_t value) {
-  return value == 0 || value == 1 || value == 3 || value == 6 || value == 8 || value == 9;
+// 6502 bit of a mode: bit 0 pp, 2 pv, 5 hm, 7 csp, 8 csv, 9 cst (CiA-402: bit mode - 1).
+constexpr uint32_t drive_mode_bit(Mode mode) { return 1u << (static_cast<int>(mode) - 1); }
+// The modes the TMCM-3216 has (its 6502): pp, pv, hm, csp, csv.
+inline constexpr uint32_t kSupportedDriveModes =
+    drive_mode_bit(Mode::kProfilePosition) | drive_mode_bit(Mode::kProfileVelocity) | drive_mode_bit(Mode::kHoming) |
+    drive_mode_bit(Mode::kCyclicSyncPosition) | drive_mode_bit(Mode::kCyclicSyncVelocity);
+// A 6060 value a drive with the modes `supported` (6502 bits) accepts: 0 (no mode) or one of them.
+constexpr bool supported_mode(uint32_t supported, int64_t value) {
+  if (value == 0) return true;
+  if (value < 1 || value > 32) return false;
+  return (supported & (1u << (value - 1))) != 0;
 }
-// 6502: bit 0 pp, 2 pv, 5 hm, 7 csp, 8 csv.
-inline constexpr uint32_t kSupportedDriveModes = (1u << 0) | (1u << 2) | (1u << 5) | (1u << 7) | (1u << 8);
+constexpr bool supported_mode(int64_t value) { return supported_mode(kSupportedDriveModes, value); }
 
 struct ProfileObjects {
   // Option codes 605A..605E.
@@ -61,6 +70,11 @@ struct ProfileObjects {
   uint8_t interpolation_period = 1;                 // 60C2 sub 1
   int8_t interpolation_index = -3;                  // 60C2 sub 2: period = sub1 x 10^sub2 s
   uint32_t encoder_increments = 1;                  // 608F sub 1 (per motor revolution)
+  // Torque (cst, where a module has it), in the module's torque unit (TMCM-1636: mA).
+  int16_t target_torque = 0;                        // 6071
+  uint16_t max_torque = 0;                          // 6072; 0 = no limit besides the motor's
+  int16_t torque_offset = 0;                        // 60B2
+  uint32_t max_profile_velocity = 0;                // 607F; 0 = no limit (objects a module lacks stay 0)
 };
 
 // A double in int32 range: the largest or smallest int32 beyond it (a cast would be undefined

@@ -83,6 +83,12 @@ struct Tmcm3216DriveObjects {
     return {};
   }
 
+  // pp, pv, hm, csp, csv (6502); every homing method of cia402::Homing (manual table 296).
+  static constexpr uint32_t kSupportedModes = cia402::kSupportedDriveModes;
+  static constexpr bool supports_homing_method(int8_t) { return true; }
+  // A stepper: the ramp is the motion.
+  static constexpr bool kServo = false;
+
   static constexpr uint16_t manufacturer_status_bits(bool motor_active, bool negative_direction) {
     return static_cast<uint16_t>((motor_active ? kSwMotorActivity : 0u) | (negative_direction ? kSwDirection : 0u));
   }
