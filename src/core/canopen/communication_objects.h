@@ -127,9 +127,10 @@ constexpr void add_storage_rows(Table& t, std::string_view store_object, const s
   }(std::make_index_sequence<N>{});
 }
 
-// 1014 ($NODEID+80h) and 1015.
+// 1014 ($NODEID+80h; `cob_id_access` ro where a firmware fixes it) and 1015.
 template <class Owner, class Table>
-constexpr void add_emergency_rows(Table& t, std::string_view cob_id_name, std::string_view inhibit_name) {
+constexpr void add_emergency_rows(Table& t, std::string_view cob_id_name, std::string_view inhibit_name,
+                                  Access cob_id_access = Access::kRw) {
   using namespace communication_rows;
   constexpr StorageGroup kComm = StorageGroup::kCommunication;
   auto cob_id = applied_binding<Owner, &CommunicationConfig::emcy_cob_id,
@@ -137,8 +138,9 @@ constexpr void add_emergency_rows(Table& t, std::string_view cob_id_name, std::s
   cob_id.check = [](Owner& d, uint8_t, int64_t v) {
     return check_emcy_cob_id(d.node().communication().emcy_cob_id, v, d.node().node_id());
   };
-  t.add(plus_node_id(var<Owner>(0x1014, cob_id_name, DataType::kUnsigned32, Access::kRw, 0, kU32Max, 0x80, cob_id,
-                                kComm)));
+  // A read-only 1014 is not stored: it is always 80h + the node ID.
+  t.add(plus_node_id(var<Owner>(0x1014, cob_id_name, DataType::kUnsigned32, cob_id_access, 0, kU32Max, 0x80, cob_id,
+                                cob_id_access == Access::kRw ? kComm : StorageGroup::kNone)));
   t.add(var<Owner>(0x1015, inhibit_name, DataType::kUnsigned16, Access::kRw, 0, kU16Max, 0,
                    applied_binding<Owner, &CommunicationConfig::emcy_inhibit_100us,
                                    [](Node& n, uint16_t v) { n.emergency().set_inhibit_time_100us(v); }>(),
@@ -195,19 +197,35 @@ constexpr void add_identity_rows(Table& t, const IdentityNames& names, const Nod
                    })));
 }
 
+// 100C (guard time, ms) and 100D (life time factor): node guarding (node_guarding.h).
+template <class Owner, class Table>
+constexpr void add_node_guarding_rows(Table& t, std::string_view guard_time_name, std::string_view life_time_name) {
+  using namespace communication_rows;
+  constexpr StorageGroup kComm = StorageGroup::kCommunication;
+  t.add(var<Owner>(0x100C, guard_time_name, DataType::kUnsigned16, Access::kRw, 0, kU16Max, 0,
+                   applied_binding<Owner, &CommunicationConfig::guard_time_ms,
+                                   [](Node& n, uint16_t v) { n.node_guarding().set_guard_time_ms(v); }>(),
+                   kComm));
+  t.add(var<Owner>(0x100D, life_time_name, DataType::kUnsigned8, Access::kRw, 0, kU8Max, 0,
+                   applied_binding<Owner, &CommunicationConfig::life_time_factor,
+                                   [](Node& n, uint8_t v) { n.node_guarding().set_life_time_factor(v); }>(),
+                   kComm));
+}
+
 // 1029 sub 1 (communication error: 0 stopped, 1 remain, 2 stopped as CiA-301 words the values)
-// and sub 2 (application error).
+// and sub 2 (application error; an empty name: the firmware has sub 1 only).
 template <class Owner, class Table>
 constexpr void add_error_behavior_rows(Table& t, std::string_view object, std::string_view count,
                                        std::string_view communication, std::string_view application) {
   using namespace communication_rows;
   constexpr StorageGroup kComm = StorageGroup::kCommunication;
-  t.add(highest_sub<Owner>(0x1029, ObjectCode::kArray, object, 2, count));
+  t.add(highest_sub<Owner>(0x1029, ObjectCode::kArray, object, application.empty() ? 1 : 2, count));
   t.add(row<Owner>(0x1029, 1, ObjectCode::kArray, object, communication, DataType::kUnsigned8, Access::kRw, 0, 2, 0,
                    field_binding<Owner, [](Owner& d, uint8_t) -> uint8_t& {
                      return d.node().communication().error_behavior[0];
                    }>(),
                    kComm));
+  if (application.empty()) return;
   t.add(row<Owner>(0x1029, 2, ObjectCode::kArray, object, application, DataType::kUnsigned8, Access::kRw, 0, 2, 1,
                    field_binding<Owner, [](Owner& d, uint8_t) -> uint8_t& {
                      return d.node().communication().error_behavior[1];

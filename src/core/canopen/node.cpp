@@ -13,6 +13,7 @@ Node::Node(RowDictionary& dictionary, board::NonVolatileMemory& nvm, board::CanC
       nmt_(can),
       sdo_(dictionary, can),
       emergency_(can),
+      node_guarding_(can),
       sync_(can),
       pdos_(dictionary, can, std::span(communication_.rpdo, description.pdo_count),
             std::span(communication_.rpdo_mapping, description.pdo_count),
@@ -88,6 +89,7 @@ void Node::reset_communication(uint32_t boot_delay_us) {
   storage_.load(communication);  // 1005..1017 reach sync_, emergency_, heartbeat_consumer_, nmt_ by their bindings
   pdos_.reset();
   sync_.reset();
+  node_guarding_.reset();
   restarting_ = true;
   restart_remaining_us_ = boot_delay_us;
   service_elapsed_us_ = 0;  // the restart time counts from the reset, not from the last service tick
@@ -140,6 +142,7 @@ void Node::process(uint32_t elapsed_us) {
   if (elapsed_us > 0) check_can_controller();
   run_nmt(elapsed_us);
   run_heartbeat_consumer(elapsed_us);
+  run_node_guarding(elapsed_us);
   const NmtState state = nmt_.state();
   if (state == NmtState::kPreOperational || state == NmtState::kOperational) {
     run_sync(elapsed_us);
@@ -283,24 +286,35 @@ bool Node::lss_store(uint8_t node_id, uint16_t bit_rate_kbit) {
 void Node::run_heartbeat_consumer(uint32_t elapsed_us) {
   switch (heartbeat_consumer_.process(elapsed_us)) {
     case HeartbeatEvent::kNone: return;
-    case HeartbeatEvent::kTimeout:
-      raise_error(kCommErrorHeartbeat, kEmcyHeartbeat);
-      // Out before a change to stopped would hold it back (unless an inhibit time is running).
-      if (nmt_.state() != NmtState::kStopped) emergency_.process(0);
-      // 1029 sub 1 (TMCM-3216 manual 3.1.14, table 39): in operational, 0 "enter stopped
-      // state", 1 "remain in current state", 2 stopped (CiA-301).
-      if (nmt_.state() == NmtState::kOperational && communication_.error_behavior[0] != 1) {
-        nmt_.enter(NmtState::kStopped);
-        sdo_.reset();
-      }
-      return;
+    case HeartbeatEvent::kTimeout: lose_master(); return;
     case HeartbeatEvent::kRecovered: clear_error(kCommErrorHeartbeat); return;
+  }
+}
+
+void Node::run_node_guarding(uint32_t elapsed_us) {
+  switch (node_guarding_.process(elapsed_us)) {
+    case GuardingEvent::kNone: return;
+    case GuardingEvent::kLifeGuardingLost: lose_master(); return;
+    case GuardingEvent::kRecovered: clear_error(kCommErrorHeartbeat); return;
+  }
+}
+
+void Node::lose_master() {
+  raise_error(kCommErrorHeartbeat, kEmcyHeartbeat);
+  // Out before a change to stopped would hold it back (unless an inhibit time is running).
+  if (nmt_.state() != NmtState::kStopped) emergency_.process(0);
+  // 1029 sub 1 (TMCM-3216 manual 3.1.14, table 39): in operational, 0 "enter stopped state",
+  // 1 "remain in current state", 2 stopped (CiA-301).
+  if (nmt_.state() == NmtState::kOperational && communication_.error_behavior[0] != 1) {
+    nmt_.enter(NmtState::kStopped);
+    sdo_.reset();
   }
 }
 
 void Node::handle_frame(const can::CanFrame& frame) {
   if (frame.extended) return;  // 11-bit COB-IDs only
   if (frame.id == kLssMasterCobId) {  // in every state, configured or not
+    if (!description_.lss) return;
     if (lss_.on_frame(frame) == LssRequest::kResetCommunication) {
       reset_communication(config_.communication_boot_delay_us);
     }
@@ -310,6 +324,11 @@ void Node::handle_frame(const can::CanFrame& frame) {
   if (frame.id == kNmtCobId) {
     nmt_.on_command(frame);
     run_nmt(0);
+    return;
+  }
+  if (NodeGuarding::is_request(frame, node_id_)) {
+    // In every NMT state but initialising: the master guards a stopped node too.
+    if (description_.node_guarding) node_guarding_.on_request(node_id_, nmt_.state(), nmt_.heartbeat_period_ms() != 0);
     return;
   }
   if (frame.id > kHeartbeatCobIdBase && frame.id <= kHeartbeatCobIdBase + 127) {
@@ -356,7 +375,7 @@ SdoAbort Node::restore_parameters(uint8_t sub, uint32_t signature) {
   const StorageSubIndex& entry = description_.storage[sub - 1];
   if (!entry.restore_supported) return SdoAbort::kDataTransfer;
   const StorageSelection& selection = entry.restore;
-  if (!selection.communication && !selection.node_settings && selection.axis_mask == 0) return SdoAbort::kNone;
+  if (selection.empty()) return SdoAbort::kNone;
   return storage_.restore_defaults(selection);
 }
 

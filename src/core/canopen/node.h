@@ -31,6 +31,7 @@
 #include "core/canopen/heartbeat_consumer.h"
 #include "core/canopen/lss_slave.h"
 #include "core/canopen/nmt.h"
+#include "core/canopen/node_guarding.h"
 #include "core/canopen/object_dictionary.h"
 #include "core/canopen/pdo.h"
 #include "core/canopen/sdo_server.h"
@@ -55,6 +56,8 @@ struct CommunicationConfig {
   uint32_t consumer_heartbeat[1];    // 1016 sub 1
   uint16_t producer_heartbeat_ms;    // 1017
   uint8_t error_behavior[2];         // 1029 sub 1, 2
+  uint16_t guard_time_ms;            // 100C
+  uint8_t life_time_factor;          // 100D
   PdoCommunication rpdo[kNodeMaxPdos];
   PdoMapping rpdo_mapping[kNodeMaxPdos];
   PdoCommunication tpdo[kNodeMaxPdos];
@@ -91,6 +94,8 @@ struct NodeDescription {
   std::span<const uint16_t> bit_rates_kbit;   // the bit rates the module supports (LSS, its objects)
   std::span<const StorageSubIndex> storage;   // 1010 / 1011 sub 1..n
   uint16_t rpdo_value_emcy;                   // an RPDO value refused (TMCM-3216 table 365: 6320)
+  bool node_guarding;                         // answers guarding requests (100C/100D); else RTR is ignored
+  bool lss;                                   // a CiA-305 LSS slave; else LSS frames are ignored
   // Bytes 3..7 of the node's own EMCYs (communication errors, the RPDO value error).
   uint8_t communication_emcy_data[5];
 };
@@ -191,6 +196,7 @@ class Node final : private LssDevice {
   SdoServer& sdo() { return sdo_; }
   EmergencyProducer& emergency() { return emergency_; }
   HeartbeatConsumer& heartbeat_consumer() { return heartbeat_consumer_; }
+  NodeGuarding& node_guarding() { return node_guarding_; }
   PdoService& pdos() { return pdos_; }
   SyncService& sync() { return sync_; }
   LssSlave& lss() { return lss_; }
@@ -219,6 +225,9 @@ class Node final : private LssDevice {
   void handle_frame(const can::CanFrame& frame);
   void run_nmt(uint32_t elapsed_us);
   void run_heartbeat_consumer(uint32_t elapsed_us);
+  void run_node_guarding(uint32_t elapsed_us);
+  // A heartbeat or life guarding event (kCommErrorHeartbeat, EMCY 8130): the 1029 sub 1 reaction.
+  void lose_master();
   void run_sync(uint32_t elapsed_us);
   void on_sync();
   void handle_pdo(const can::CanFrame& frame);
@@ -260,6 +269,7 @@ class Node final : private LssDevice {
   SdoServer sdo_;
   EmergencyProducer emergency_;
   HeartbeatConsumer heartbeat_consumer_;
+  NodeGuarding node_guarding_;
   SyncService sync_;
   PdoService pdos_;
   LssSlave lss_;

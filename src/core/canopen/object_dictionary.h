@@ -67,6 +67,7 @@ enum class StorageGroup : uint8_t {
   kCommunication,  // 1005..1029, PDO parameters: saved by 1010 sub 1 only
   kNodeSettings,   // 2704 bit rate, 2705 node ID: 1010 sub 1 and 2, 2706 sub 1
   kAxis,           // motor n parameters: 1010 sub 1 and sub 4 + n
+  kApplication,    // device-wide application objects (TMCM-1636: the manufacturer area, 1010 sub 3)
 };
 
 // One sub-index as the manual's entry-description tables give it. Pure data.

@@ -47,7 +47,10 @@ struct StorageImage {
 struct StorageSelection {
   bool communication = false;
   bool node_settings = false;
+  bool application = false;
   uint8_t axis_mask = 0;  // bit n: motor n
+
+  constexpr bool empty() const { return !communication && !node_settings && !application && axis_mask == 0; }
 
   constexpr bool contains(StorageGroup group, uint8_t axis) const {
     switch (group) {
@@ -55,6 +58,7 @@ struct StorageSelection {
       case StorageGroup::kCommunication: return communication;
       case StorageGroup::kNodeSettings: return node_settings;
       case StorageGroup::kAxis: return axis < 8 && (axis_mask & (1u << axis)) != 0;
+      case StorageGroup::kApplication: return application;
     }
     return false;
   }

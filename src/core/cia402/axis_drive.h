@@ -41,7 +41,8 @@
 //       velocity); true: a closed loop follows it and the actual motion is measured (606C is the
 //       measured velocity, AxisInputs::actual_velocity_pps), so the profile generator restarts from
 //       the measured motion whenever the motion is handed over (a mode change, the power stage off,
-//       leaving cst).
+//       leaving cst); a position assignment (homing) is the module's to carry out on the axis'
+//       counter (take_position_assignment), the drive does not re-base the reading.
 // The member definitions are in axis_drive_impl.h, compiled once per module where the module
 // instantiates its drive (the TMCM-3216: src/core/modules/tmcm3216/tmcm3216_drive.{h,cpp}).
 #pragma once

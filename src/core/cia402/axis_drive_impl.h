@@ -103,7 +103,9 @@ bool AxisDrive<Manufacturer>::take_position_assignment(int32_t& position) {
 
 template <class Manufacturer>
 void AxisDrive<Manufacturer>::assign_position(int32_t position) {
-  encoder_offset_ = drive_detail::difference(position, last_encoder_usteps_);
+  // A stepper's encoder keeps its own count: it is re-based. A servo's module sets the axis'
+  // counter itself (take_position_assignment), so the next reading is the new position.
+  if constexpr (!Manufacturer::kServo) encoder_offset_ = drive_detail::difference(position, last_encoder_usteps_);
   ramp_.set_position(position);
   ramp_.halt();
   target_ = position;

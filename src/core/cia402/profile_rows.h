@@ -41,12 +41,13 @@ constexpr ProfileRow with_default(std::string_view name, int64_t default_value, 
   return {true, name, default_value, mappable};
 }
 
-// An ARRAY or RECORD's names: the object, sub 0, subs 1 and 2.
+// An ARRAY or RECORD's names: the object, sub 0, subs 1 and 2; and sub 0's access (ro or const).
 struct ProfileArrayNames {
   std::string_view object;
   std::string_view count;
   std::string_view first;
   std::string_view second;
+  canopen::Access count_access;
 };
 
 struct ProfileRows {
@@ -179,6 +180,14 @@ constexpr EntryRow<Owner> offset_var(uint16_t index, const ProfileRow& p, uint16
                   stride, p.mappable, false);
 }
 
+// Sub 0 of 607D, 6099, 60C2: 2.
+template <class Owner>
+constexpr EntryRow<Owner> array_head(uint16_t index, ObjectCode code, const ProfileArrayNames& names, uint16_t stride) {
+  EntryRow<Owner> head = canopen::rows::per_axis(canopen::rows::highest_sub<Owner>(index, code, names.object, 2, names.count), stride);
+  head.info.access = names.count_access;
+  return head;
+}
+
 template <class Owner>
 SdoAbort check_quick_stop_option(Owner&, uint8_t, int64_t v) {
   return valid_quick_stop_option(v) ? SdoAbort::kNone : SdoAbort::kInvalidValue;
@@ -212,9 +221,6 @@ constexpr void add_profile_rows(Table& t, const ProfileRows& p) {
   constexpr int64_t kI8Max = 127;
   constexpr int64_t kI16Min = -32768;
   constexpr int64_t kI16Max = 32767;
-  const auto array_head = [&](uint16_t index, ObjectCode code, const ProfileArrayNames& names) {
-    t.add(r::per_axis(r::highest_sub<Owner>(index, code, names.object, 2, names.count), s));
-  };
 
   // 6040 / 6041: the PDS (not stored).
   {
@@ -279,7 +285,7 @@ constexpr void add_profile_rows(Table& t, const ProfileRows& p) {
   t.add(set_point<Owner, &O::target_position, &Drive::target_position_written>(0x607A, p.target_position, s, kInteger32,
                                                                               r::kI32Min, r::kI32Max));
   t.add(config_var<Owner, &O::home_offset>(0x607C, p.home_offset, s, kInteger32, r::kI32Min, r::kI32Max));
-  array_head(0x607D, ObjectCode::kArray, p.software_limit_names);
+  t.add(array_head<Owner>(0x607D, ObjectCode::kArray, p.software_limit_names, s));
   t.add(config_entry<Owner, &O::software_limit_min>(0x607D, 1, ObjectCode::kArray, p.software_limit_names.object,
                                                     p.software_limit_names.first, s, kInteger32, r::kI32Min,
                                                     r::kI32Max, r::kI32Min));
@@ -314,9 +320,7 @@ constexpr void add_profile_rows_from_homing(Table& t, const ProfileRows& p) {
   constexpr int64_t kI16Max = 32767;
   t.add(config_var<Owner, &O::homing_method>(0x6098, p.homing_method, s, kInteger8, kI8Min, kI8Max,
                                              &check_homing_method<Owner>));
-  t.add(r::per_axis(r::highest_sub<Owner>(0x6099, ObjectCode::kArray, p.homing_speed_names.object, 2,
-                                          p.homing_speed_names.count),
-                    s));
+  t.add(array_head<Owner>(0x6099, ObjectCode::kArray, p.homing_speed_names, s));
   t.add(config_entry<Owner, &O::homing_speed_fast>(0x6099, 1, ObjectCode::kArray, p.homing_speed_names.object,
                                                    p.homing_speed_names.first, s, kUnsigned32, 0, r::kU32Max, 0));
   t.add(config_entry<Owner, &O::homing_speed_slow>(0x6099, 2, ObjectCode::kArray, p.homing_speed_names.object,
@@ -327,9 +331,7 @@ constexpr void add_profile_rows_from_homing(Table& t, const ProfileRows& p) {
   if (p.torque_offset.present) {
     t.add(offset_var<Owner, &O::torque_offset>(0x60B2, p.torque_offset, s, kInteger16, kI16Min, kI16Max));
   }
-  t.add(r::per_axis(r::highest_sub<Owner>(0x60C2, ObjectCode::kRecord, p.interpolation_names.object, 2,
-                                          p.interpolation_names.count),
-                    s));
+  t.add(array_head<Owner>(0x60C2, ObjectCode::kRecord, p.interpolation_names, s));
   t.add(config_entry<Owner, &O::interpolation_period>(0x60C2, 1, ObjectCode::kRecord, p.interpolation_names.object,
                                                       p.interpolation_names.first, s, kUnsigned8, 0, r::kU8Max,
                                                       p.interpolation_period.default_value));

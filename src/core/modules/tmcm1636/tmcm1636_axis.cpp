@@ -46,7 +46,22 @@ const motion::TrapezoidRampConfig& Tmcm1636Axis::ideal_ramp_config() {
 // A servo starts a new mode from the motion it measures, so that a mode change is bumpless.
 void Tmcm1636Axis::seed_ramp() { ramp_.set_state(state.actual_position, servo_.velocity_counts_per_s); }
 
+void Tmcm1636Axis::follow_position(int32_t position, double velocity_counts_per_s) {
+  state.mode = MotionMode::kPosition;
+  external_reference_ = true;
+  ramp_.set_state(position, velocity_counts_per_s);
+  ramp_.set_position_target(position);
+}
+
+void Tmcm1636Axis::follow_velocity(double velocity_counts_per_s) {
+  state.mode = MotionMode::kVelocity;
+  external_reference_ = true;
+  state.target_velocity_rpm = round_to_int32(rpm(velocity_counts_per_s));
+  ramp_.set_velocity_target(velocity_counts_per_s);
+}
+
 void Tmcm1636Axis::set_target_velocity(int32_t velocity_rpm) {
+  external_reference_ = false;
   if (power_stage_ != nullptr && state.mode != MotionMode::kVelocity) seed_ramp();
   state.mode = MotionMode::kVelocity;
   state.target_velocity_rpm = velocity_rpm;
@@ -54,6 +69,7 @@ void Tmcm1636Axis::set_target_velocity(int32_t velocity_rpm) {
 }
 
 void Tmcm1636Axis::set_target_position(int32_t position) {
+  external_reference_ = false;
   if (power_stage_ != nullptr && state.mode != MotionMode::kPosition) seed_ramp();
   state.mode = MotionMode::kPosition;
   ramp_.set_position_target(position);
@@ -69,12 +85,14 @@ void Tmcm1636Axis::set_actual_position(int32_t position) {
 // Torque and flux targets select current regulation (manual table 11, AP 30/32). The ideal
 // motor has no torque model: it stands still in this mode (docs/tmcm-1636.md).
 void Tmcm1636Axis::set_target_torque(int32_t torque_ma) {
+  external_reference_ = false;
   state.mode = MotionMode::kTorque;
   state.target_torque_ma = torque_ma;
   ramp_.halt();
 }
 
 void Tmcm1636Axis::set_target_flux(int32_t flux_ma) {
+  external_reference_ = false;
   state.mode = MotionMode::kTorque;
   state.target_flux_ma = flux_ma;
   ramp_.halt();
@@ -111,6 +129,7 @@ void Tmcm1636Axis::set_clear_on_null(int32_t clear) {
 }
 
 void Tmcm1636Axis::reset_state() {
+  external_reference_ = false;
   state = AxisState{};
   ramp_ = motion::TrapezoidRamp{};
   servo_ = Servo{};
@@ -155,7 +174,14 @@ void Tmcm1636Axis::ideal_tick(const board::Tmcm1636Io& io, double dt_s) {
   if (io.reference_switch_level(board::ReferenceSwitch::kLeft)) levels |= 2;
   if (io.reference_switch_level(board::ReferenceSwitch::kHome)) levels |= 4;
   update_switches(levels);
-  if (state.driver_enabled != 0 && state.mode != MotionMode::kTorque) {
+  if (state.driver_enabled != 0 && external_reference_) {
+    // The reference is the motion: a position is where the ramp was set, a velocity moves it.
+    if (state.mode == MotionMode::kVelocity) {
+      motion::TrapezoidRampConfig follow = ideal_ramp_config();
+      follow.ramp_enabled = false;
+      ramp_.step(follow, dt_s);
+    }
+  } else if (state.driver_enabled != 0 && state.mode != MotionMode::kTorque) {
     // Re-derived every tick: AP 100 (counts per revolution) may have changed.
     if (state.mode == MotionMode::kVelocity) ramp_.set_velocity_target(counts_per_second(state.target_velocity_rpm));
     ramp_.step(ideal_ramp_config(), dt_s);

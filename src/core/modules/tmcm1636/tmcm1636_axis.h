@@ -205,6 +205,15 @@ class Tmcm1636Axis {
   // AP 107: writing it re-arms the clear on the next N pulse.
   void set_clear_on_null(int32_t clear);
 
+  // A reference generated outside the axis: the CANopen firmware's CiA-402 drive profiles the
+  // motion (docs/tmcm-1636-canopen.md) and hands the axis, every tick before tick(), a position
+  // (axis counts) with its velocity as the feed-forward of the position regulator, or a velocity
+  // for the velocity regulator. The axis' own ramp (AP 43..45) is then not used; AP 43 still
+  // bounds the velocity reference. Any other command (set_target_*) ends it.
+  void follow_position(int32_t position, double velocity_counts_per_s);
+  void follow_velocity(double velocity_counts_per_s);
+  bool following_reference() const { return external_reference_; }
+
   // The motor behind the power stage. nullptr (the default) is the ideal motor. The stage is
   // board wiring: it survives reset_state().
   void attach_power_stage(board::Tmcm1636PowerStage* stage) { power_stage_ = stage; }
@@ -380,6 +389,7 @@ class Tmcm1636Axis {
   double counts_per_s_per_rpm_ = 8192.0 / 60.0;
   board::Tmcm1636PowerStage* power_stage_ = nullptr;
   bool position_scaler_applies_ = false;
+  bool external_reference_ = false;  // follow_position / follow_velocity
   // Set by reset_state(), cleared by the first tick: parameter writes in between are the
   // power-up restore, not host commands.
   bool restoring_ = false;

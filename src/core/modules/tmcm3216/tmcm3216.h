@@ -103,6 +103,8 @@ class Tmcm3216 final : private canopen::NodeApplication {
       .bit_rates_kbit = kBitRatesKbit,
       .storage = kStorageSubIndices,
       .rpdo_value_emcy = kEmcyPdoParameter,
+      .node_guarding = false,  // manual 1.1: RTR frames are not answered
+      .lss = true,
       // Manual table 365: byte 2 is the motor, 255 for the communication errors.
       .communication_emcy_data = {0, 255, 0, 0, 0},
   };

@@ -1,0 +1,194 @@
+// The TMCM-1636 with its CANopen firmware (V1.12, as Trinamic's published EDS describes it): a
+// CANopen node (core/canopen/node.h) with the EDS's identity, communication objects, PDO defaults
+// and node guarding, and the application behind it: one CiA-402 drive (Tmcm1636Drive: pp, pv, hm,
+// csp, csv, cst) whose demand the servo axis of the TMCL firmware follows (Tmcm1636Axis: the same
+// FOC current, velocity and position regulators, hall/ABN/absolute commutation, encoder
+// initialisation, brake, brake chopper and protections, on the same board seam), the manufacturer
+// objects 2003..2140 bound to that axis' settings, and the I/O (2702, 2703, 270E, 60FD).
+// docs/tmcm-1636-canopen.md.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "board/can_controller.h"
+#include "board/modules/tmcm1636/tmcm1636_io.h"
+#include "board/non_volatile_memory.h"
+#include "core/canopen/node.h"
+#include "core/canopen/object_dictionary.h"
+#include "core/modules/tmcm1636/tmcm1636_axis.h"
+#include "core/modules/tmcm1636/tmcm1636_canopen_drive.h"
+#include "core/modules/tmcm1636/tmcm1636_hardware.h"
+#include "types/can_frame.h"
+
+namespace motwin::modules::tmcm1636 {
+
+inline constexpr uint8_t kCanopenPdoCount = 4;         // RPDO/TPDO 1..4 (EDS NrOfRXPDO, NrOfTXPDO)
+inline constexpr uint8_t kCanopenMappedObjects = 3;    // mapping sub-indices 1..3
+
+// The EDS's BaudRate_* keys: no 10 and no 100 kbit/s.
+inline constexpr uint16_t kCanopenBitRatesKbit[] = {20, 50, 125, 250, 500, 800, 1000};
+
+// 1010 / 1011 sub 1 all (restore: all but the node ID and bit rate, which would cut the module off
+// its bus), sub 2 communication (store: with the node ID and bit rate 2704/2705, the TMCM-1690
+// manual's procedure), sub 3 application (the manufacturer objects: motor, sensors, regulators,
+// I/O), sub 4 axis 0 (its CiA-402 settings). docs/tmcm-1636-canopen.md "Storage".
+inline constexpr canopen::StorageSubIndex kCanopenStorage[] = {
+    {true, {.communication = true, .node_settings = true, .application = true, .axis_mask = 1}, true,
+     {.communication = true, .application = true, .axis_mask = 1}},
+    {true, {.communication = true, .node_settings = true}, true, {.communication = true}},
+    {true, {.application = true}, true, {.application = true}},
+    {true, {.axis_mask = 1}, true, {.axis_mask = 1}},
+};
+
+// 2005 Switch Parameters (the bit layout of the Trinamic CANopen firmwares, TMCM-3216 manual
+// 4.2.6): bit 0 / 1 left / right limit switch not used, bit 2 / 3 left / right inverted, bit 5
+// home switch inverted.
+inline constexpr uint32_t kSwitchLeftUnused = 1u << 0;
+inline constexpr uint32_t kSwitchRightUnused = 1u << 1;
+inline constexpr uint32_t kSwitchLeftInverted = 1u << 2;
+inline constexpr uint32_t kSwitchRightInverted = 1u << 3;
+inline constexpr uint32_t kSwitchHomeInverted = 1u << 5;
+
+// 2101 Status Flags, the layout PyTrinamic's TMCM-1636 CANopen example decodes (with the family's
+// other bits; docs/tmcm-1636-canopen.md "Status flags").
+namespace canopen_status_flag {
+inline constexpr uint32_t kOvercurrent = 1u << 0;
+inline constexpr uint32_t kUndervoltage = 1u << 1;
+inline constexpr uint32_t kOvervoltage = 1u << 2;
+inline constexpr uint32_t kOvertemperature = 1u << 3;
+inline constexpr uint32_t kMotorHalted = 1u << 4;
+inline constexpr uint32_t kHallError = 1u << 5;
+inline constexpr uint32_t kStopMode = 1u << 8;
+inline constexpr uint32_t kVelocityMode = 1u << 9;
+inline constexpr uint32_t kPositionMode = 1u << 10;
+inline constexpr uint32_t kTorqueMode = 1u << 11;
+inline constexpr uint32_t kPositionEnd = 1u << 14;
+inline constexpr uint32_t kInitialized = 1u << 15;
+}  // namespace canopen_status_flag
+
+// The objects of the module that are neither the axis' settings nor the drive's.
+struct Tmcm1636CanopenObjects {
+  uint32_t switch_parameters = kSwitchLeftUnused | kSwitchRightUnused;  // 2005 (EDS default 3)
+  uint32_t outputs = 0;      // 2703 sub 1: bit n drives GPO n
+  uint32_t output_mask = 0;  // 2703 sub 2: which bits a write of sub 1 changes
+};
+
+class Tmcm1636Canopen final : private canopen::NodeApplication {
+ public:
+  using Dictionary = canopen::TableDictionary<Tmcm1636Canopen>;
+  using Row = canopen::EntryRow<Tmcm1636Canopen>;
+
+  static constexpr std::string_view kName = "tmcm-1636";
+  static constexpr std::string_view kDeviceName = "TMCM-1636";   // 1008
+  static constexpr std::string_view kHardwareVersion = "1.1";    // 1009: the EDS file's "Hw1.1"
+  static constexpr std::string_view kSoftwareVersion = "1.12";   // 100A
+  static constexpr std::string_view kFirmwareVersion = "CANopen V1.12";
+  // 1000 as the EDS gives it: profile 402, servo drive (bit 17), bit 22 set.
+  static constexpr uint32_t kDeviceType = 0x0042'0192;
+  static constexpr uint32_t kSingleDeviceType = 0x0002'0192;  // 67FF
+  static constexpr uint32_t kVendorId = 0x0000'0286;
+  static constexpr uint32_t kProductCode = 0x664;  // 1636
+  static constexpr uint32_t kRevisionNumber = 0x0001'000C;
+
+  static constexpr uint32_t kNvmLayoutVersion = 1;
+  static constexpr size_t kNvmRecordCapacity = 512;
+  static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
+  // The restart times `motwin serve` gives the module unless told otherwise: the TMCM-3216's
+  // (docs/canopen.md "Start-up timing"); no source gives the TMCM-1636's.
+  static constexpr uint32_t kBootDelayUs = 300'000;
+  static constexpr uint32_t kCommunicationBootDelayUs = 50'000;
+
+  static constexpr canopen::NodeDescription kNode{
+      .identity = {kVendorId, kProductCode, kRevisionNumber},
+      .pdo_count = kCanopenPdoCount,
+      .bit_rates_kbit = kCanopenBitRatesKbit,
+      .storage = kCanopenStorage,
+      .rpdo_value_emcy = 0x6320,  // the family's "parameter error" (TMCM-3216 table 365, TMCM-1690)
+      .node_guarding = true,      // 100C / 100D
+      .lss = false,               // the EDS's LSS_Supported=0
+      .communication_emcy_data = {0, 255, 0, 0, 0},
+  };
+
+  // Every object of the dictionary (tmcm1636_canopen_objects.cpp).
+  static std::span<const Row> object_table();
+  // An image with nothing stored: every object at its default.
+  static void format_factory_image(uint8_t* image, size_t size);
+
+  Tmcm1636Canopen(board::NonVolatileMemory& nvm, board::CanController& can, board::Tmcm1636Io& io,
+                  const canopen::NodeConfig& config = {});
+  Tmcm1636Canopen(const Tmcm1636Canopen&) = delete;
+  Tmcm1636Canopen& operator=(const Tmcm1636Canopen&) = delete;
+
+  // Power-on: every object from the NVM (or its default); after the boot delay the boot-up.
+  void power_up() { node_.power_up(); }
+  bool receive(const can::CanFrame& frame) { return node_.receive(frame); }
+  void process(uint32_t elapsed_us) { node_.process(elapsed_us); }
+  // One 50 µs control tick: the node's services (once per millisecond, or at once for a frame),
+  // then the drive and the axis' regulators.
+  void tick();
+
+  canopen::Node& node() { return node_; }
+  uint8_t node_id() const { return node_.node_id(); }
+  uint16_t bit_rate_kbit() const { return node_.bit_rate_kbit(); }
+  bool configured() const { return node_.configured(); }
+  canopen::NmtState nmt_state() const { return node_.nmt_state(); }
+  uint8_t error_register() const { return node_.error_register(); }
+  Dictionary& dictionary() { return dictionary_; }
+  Tmcm1636Drive& drive(uint8_t /*axis*/ = 0) { return drive_; }
+  const Tmcm1636Drive& drive(uint8_t /*axis*/ = 0) const { return drive_; }
+  Tmcm1636Axis& axis() { return axis_; }
+  const Tmcm1636Axis& axis() const { return axis_; }
+  board::Tmcm1636Io& io() { return io_; }
+  Tmcm1636CanopenObjects& objects() { return objects_; }
+
+  // Positions, velocities and torques between the drive's frame (2058 units per revolution, the
+  // host's direction, 2057) and the axis' (AP 100 = 2080:2 counts per revolution, the motor's).
+  int32_t drive_position(int32_t axis_counts) const;
+  int32_t axis_position(int32_t drive_units) const;
+  double drive_velocity(double axis_counts_per_s) const;
+  double axis_velocity(double drive_units_per_s) const;
+  int32_t directed(int32_t value) const {
+    return axis_.config.motor_direction != 0 ? static_cast<int32_t>(0u - static_cast<uint32_t>(value)) : value;
+  }
+
+  // 2101: the axis' state in the firmware family's layout.
+  uint32_t status_flags() const;
+  // 60FD: bit 0 negative (left) limit switch, 1 positive (right), 2 home switch (active, as 2005
+  // configures them), bits 16..19 GPI 0..3.
+  uint32_t digital_inputs() const;
+  // 2702: the general-purpose inputs' levels, bit n = GPI n.
+  uint32_t device_digital_inputs() const;
+  // 2703 sub 1 written: the bits the mask (sub 2) allows change, the outputs follow.
+  void write_outputs(uint32_t value);
+
+ private:
+  // canopen::NodeApplication.
+  void reset_application() override;
+  void on_sync() override { drive_.on_sync(); }
+  void on_bus_off() override;
+  uint8_t application_error_register() const override;
+
+  void run_axis(uint32_t dt_us);
+  cia402::AxisInputs axis_inputs() const;
+  void carry_out(const cia402::AxisDemand& demand);
+  void report_drive_emergencies();
+  void apply_outputs();
+
+  board::Tmcm1636Io& io_;
+  Tmcm1636Axis axis_{};
+  Tmcm1636Drive drive_{};
+  Tmcm1636CanopenObjects objects_{};
+  bool driver_enabled_ = false;  // what the axis was last told (AP 255)
+
+  Dictionary dictionary_;
+  std::array<uint8_t, kNvmSize> storage_scratch_{};
+  canopen::Node node_;
+};
+
+}  // namespace motwin::modules::tmcm1636
+
+extern template class motwin::canopen::TableDictionary<motwin::modules::tmcm1636::Tmcm1636Canopen>;
