@@ -123,7 +123,7 @@ std::string status_text(tmcl::Status status) {
 
 // The options, checked: which module, how long, what to trace.
 struct RunPlan {
-  const host::ModuleDescriptor* descriptor = nullptr;
+  host::ModuleDescriptor descriptor{};  // --module running --firmware
   uint64_t duration_us = 0;
   uint64_t sample_us = 0;
   std::vector<uint8_t> params;     // axis parameters of --axis (--param; default: the module's)
@@ -132,16 +132,20 @@ struct RunPlan {
 
 Result<RunPlan> check_options(const RunOptions& options) {
   RunPlan plan;
-  plan.descriptor = host::find_module(options.module);
-  if (plan.descriptor == nullptr) {
+  const host::ModuleDescriptor* module = host::find_module(options.module);
+  if (module == nullptr) {
     return Error{fmt::format("unknown module \"{}\" (available: {})", options.module, host::module_names())};
   }
-  if (!plan.descriptor->endpoints.has_tmcl()) {
-    return Error{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", options.module,
+  const auto no_interpreter = [](const std::string& what) {
+    return Error{fmt::format("{} has no TMCL interpreter (motwin run takes a TMCL module: {})", what,
                              host::module_names(&host::has_tmcl))};
-  }
-  const Result<const host::FirmwareGeneration*> firmware = host::find_firmware(*plan.descriptor, options.firmware);
-  if (!firmware) return Error{firmware.error()};
+  };
+  if (!module->endpoints.has_tmcl()) return no_interpreter(options.module);
+  Result<host::ModuleDescriptor> running = host::with_firmware(*module, options.firmware);
+  if (!running) return Error{running.error()};
+  plan.descriptor = std::move(*running);
+  // A generation that speaks another protocol (a CANopen firmware of a TMCL module).
+  if (!plan.descriptor.endpoints.has_tmcl()) return no_interpreter(options.module + " --firmware " + options.firmware);
   const std::optional<uint64_t> duration_us = parse_duration_us(options.duration);
   if (!duration_us) {
     return Error{fmt::format("--for {}: expected a duration such as 10s, 500ms or 2.5s", options.duration)};
@@ -156,7 +160,7 @@ Result<RunPlan> check_options(const RunOptions& options) {
   Result<std::vector<uint8_t>> params = parse_numbers(options.params, "--param");
   if (!params) return Error{params.error()};
   // Default columns: the module's actual position and velocity.
-  plan.params = options.params.empty() ? plan.descriptor->trace_parameters : std::move(*params);
+  plan.params = options.params.empty() ? plan.descriptor.trace_parameters : std::move(*params);
   Result<std::vector<uint8_t>> variables = parse_numbers(options.variables, "--var");
   if (!variables) return Error{variables.error()};
   plan.variables = std::move(*variables);
@@ -210,12 +214,11 @@ struct Column {
 
 // The trace's name for the page's legend and its unit, from the module's parameter listing
 // ("AP52 actual position", "counts").
-void describe_columns(const RunOptions& options, const RunPlan& plan, std::vector<host::web::TraceColumn>& described) {
-  const Result<host::ModuleParameterListing> listing = host::firmware_listing(*plan.descriptor, options.firmware);
+void describe_columns(const RunPlan& plan, std::vector<host::web::TraceColumn>& described) {
+  const host::ModuleParameterListing listing = plan.descriptor.listing();
   const auto find = [&listing](host::ParameterKind kind, std::optional<uint8_t> bank,
                                uint8_t number) -> const host::ListedParameter* {
-    if (!listing) return nullptr;
-    for (const host::ParameterSection& section : listing->sections) {
+    for (const host::ParameterSection& section : listing.sections) {
       if (section.kind != kind || section.bank != bank) continue;
       for (const host::ListedParameter& parameter : section.parameters) {
         if (number >= parameter.first_number && number <= parameter.last_number) return &parameter;
@@ -444,17 +447,15 @@ Result<PlotOutput> open_plot(const RunOptions& options, const RunPlan& plan, con
   if (!file) return Error{file.error()}.with_context("--plot: ");
   PlotOutput plot{std::move(*file), {}};
   host::web::TracePageData& page = plot.page;
-  const Result<const host::FirmwareGeneration*> generation = host::find_firmware(*plan.descriptor, options.firmware);
   page.module = module.name();
-  page.firmware = generation && *generation != nullptr ? std::string((*generation)->version)
-                                                       : std::string(plan.descriptor->firmware);
+  page.firmware = std::string(plan.descriptor.firmware);
   page.program = options.program;
   page.started_utc = utc_now();
   page.sample_s = static_cast<double>(plan.sample_us) / 1e6;
   const size_t slash = options.program.find_last_of('/');
   page.title = fmt::format("{} on {}, {}", slash == std::string::npos ? options.program : options.program.substr(slash + 1),
                            page.module, page.started_utc);
-  describe_columns(options, plan, page.columns);
+  describe_columns(plan, page.columns);
   return plot;
 }
 
@@ -468,10 +469,10 @@ int run_run(const RunOptions& options) {
   if (!address) return usage_error(address.error());
 
   Result<ModuleInputs> inputs =
-      read_module_inputs(plan->descriptor->input_signals(), options.assignments, options.scenario_path);
+      read_module_inputs(plan->descriptor.input_signals(), options.assignments, options.scenario_path);
   if (!inputs) return usage_error(inputs.error());
   const Result<std::unique_ptr<host::VirtualModule>> made =
-      make_module_to_run(options, *plan->descriptor, std::move(inputs->initial_inputs));
+      make_module_to_run(options, plan->descriptor, std::move(inputs->initial_inputs));
   if (!made) return usage_error(made.error());
   host::VirtualModule& module = **made;
   const Result<TickPlan> ticks = ticks_of(options, *plan, module.tick_period_us());

@@ -155,7 +155,8 @@ Result<std::vector<T>> parse_each(const std::vector<std::string>& texts, Parse p
 
 // What runs: one module (--module) or several on one bus (--node), with their options.
 struct ModulePlan {
-  const host::ModuleDescriptor* descriptor = nullptr;  // --module (with --node: the nodes' own)
+  // --module running --firmware (with --node: the nodes' own, host::node_module).
+  host::ModuleDescriptor descriptor{};
   std::vector<host::NodeSpec> nodes;
   host::Pacing pacing;
   host::ModuleOptions options;  // with --node only the state directory applies
@@ -201,18 +202,15 @@ Result<void> check_node_options(const ServeArguments& arguments) {
 
 Result<ModulePlan> check_module_arguments(const ServeArguments& arguments) {
   ModulePlan plan;
-  plan.descriptor = host::find_module(arguments.module);
-  if (plan.descriptor == nullptr) {
-    return Error{"unknown module \"" + arguments.module + "\" (available: " + host::module_names() + ")"};
-  }
-  const Result<const host::FirmwareGeneration*> firmware = host::find_firmware(*plan.descriptor, arguments.firmware);
-  if (!firmware) return Error{firmware.error()};
+  Result<host::ModuleDescriptor> descriptor = host::find_module_with_firmware(arguments.module, arguments.firmware);
+  if (!descriptor) return Error{descriptor.error()};
+  plan.descriptor = std::move(*descriptor);
   plan.options.firmware = arguments.firmware;
   const Result<host::Pacing> pacing = host::Pacing::parse(arguments.speed);
   if (!pacing) return Error{pacing.error()};
   plan.pacing = *pacing;
   Result<ModuleInputs> inputs =
-      read_module_inputs(plan.descriptor->input_signals(), arguments.assignments, arguments.scenario_path);
+      read_module_inputs(plan.descriptor.input_signals(), arguments.assignments, arguments.scenario_path);
   if (!inputs) return Error{inputs.error()};
   plan.options.initial_inputs = std::move(inputs->initial_inputs);
   plan.scenario = std::move(inputs->scenario);
@@ -234,13 +232,14 @@ Result<ModulePlan> check_module_arguments(const ServeArguments& arguments) {
     plan.options.communication_boot_delay_ms = static_cast<uint32_t>(arguments.comm_boot_delay_ms);
   }
   const bool delays_given = plan.options.boot_delay_ms || plan.options.communication_boot_delay_ms;
-  if (plan.nodes.empty() && delays_given && plan.descriptor->canopen == nullptr) {
+  if (plan.nodes.empty() && delays_given && plan.descriptor.canopen == nullptr) {
     return Error{"--boot-delay-ms and --comm-boot-delay-ms are for CANopen modules (" +
                  host::module_names([](const host::ModuleDescriptor& module) { return module.canopen != nullptr; }) +
                  ")"};
   }
   for (host::NodeSpec& node : plan.nodes) {
-    if (host::find_module(node.module)->canopen == nullptr) continue;
+    const Result<host::ModuleDescriptor> node_module = host::node_module(node);
+    if (!node_module || node_module->canopen == nullptr) continue;
     if (!node.boot_delay_ms) node.boot_delay_ms = plan.options.boot_delay_ms;
     if (!node.communication_boot_delay_ms) node.communication_boot_delay_ms = plan.options.communication_boot_delay_ms;
   }
@@ -293,7 +292,7 @@ Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, c
   plan.can = std::move(*can);
   if (plan.tmcl_tcp.empty() && plan.tmcl_pty_link.empty() && plan.can.empty()) {
     // Nodes are on the bus; a single module where its descriptor puts it.
-    if (module.nodes.empty() && module.descriptor->endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
+    if (module.nodes.empty() && module.descriptor.endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
       plan.tmcl_tcp.push_back(host::TcpEndpointSpec{});  // 127.0.0.1:5000
     } else {
       plan.can.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
@@ -304,7 +303,7 @@ Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, c
   plan.can_bit_rate = *bit_rate;
   if (Result<void> combined = check_node_options(arguments); !combined) return Error{combined.error()};
   if (module.nodes.empty()) {
-    if (Result<void> offered = check_offered(*module.descriptor, plan); !offered) return Error{offered.error()};
+    if (Result<void> offered = check_offered(module.descriptor, plan); !offered) return Error{offered.error()};
   }
   // These watch the bus.
   if (plan.can.empty() && !arguments.can_capture.empty()) return Error{"--can-capture needs a CAN bus (--can)"};
@@ -366,7 +365,7 @@ struct ServedModule {
 
 Result<ServedModule> make_served_module(const ModulePlan& plan) {
   if (plan.nodes.empty()) {
-    Result<std::unique_ptr<host::VirtualModule>> module = plan.descriptor->make(plan.options);
+    Result<std::unique_ptr<host::VirtualModule>> module = plan.descriptor.make(plan.options);
     if (!module) return Error{module.error()};
     return ServedModule{std::move(*module)};
   }
@@ -493,11 +492,11 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
   if (served.group == nullptr) {
     const host::VirtualModule& single = *served.module;
     if (runtime.has_tmcl_service()) {
-      targets.push_back(tools::web::tmcl_target(*module.descriptor, std::string(single.name()),
+      targets.push_back(tools::web::tmcl_target(module.descriptor, std::string(single.name()),
                                                 std::string(single.firmware_version()), module.options.firmware,
                                                 &runtime.service()));
     } else {
-      targets.push_back(tools::web::canopen_target(*module.descriptor, std::string(single.name()),
+      targets.push_back(tools::web::canopen_target(module.descriptor, std::string(single.name()),
                                                    std::string(single.firmware_version()),
                                                    configured_node_id(module.options.node_id)));
     }
@@ -508,7 +507,9 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
     for (size_t i = 0; i < module.nodes.size(); ++i) {
       const host::NodeSpec& spec = module.nodes[i];
       const host::ModuleGroup::Member& member = served.group->members()[i];
-      const host::ModuleDescriptor& descriptor = *host::find_module(spec.module);
+      const Result<host::ModuleDescriptor> node_module = host::node_module(spec);  // checked by parse_node_spec
+      if (!node_module) return Error{node_module.error()};
+      const host::ModuleDescriptor& descriptor = *node_module;
       const std::string firmware(member.module->firmware_version());
       targets.push_back(descriptor.canopen != nullptr
                             ? tools::web::canopen_target(descriptor, member.name, firmware,
@@ -674,14 +675,14 @@ int run_serve(const ServeArguments& arguments) {
   return kExitSuccess;
 }
 
-// "Endpoints: --tmcl-tcp, ...; default ..." for a module's part of the help.
-std::string endpoints_help(const host::ModuleEndpoints& endpoints) {
+// "Endpoints: --tmcl-tcp, ...; default ..." for a module's part of the help, after `indent`.
+std::string endpoints_help(const host::ModuleEndpoints& endpoints, std::string_view indent = "  ") {
   std::vector<std::string> offered;
   if (endpoints.tmcl_tcp) offered.push_back("--tmcl-tcp");
   if (endpoints.tmcl_pty) offered.push_back("--tmcl-pty");
   if (endpoints.tmcl_can) offered.push_back("--can (TMCL on GP 71/70)");
   if (endpoints.canopen) offered.push_back("--can (CANopen)");
-  std::string text = "  Endpoints: ";
+  std::string text = std::string(indent) + "Endpoints: ";
   for (size_t i = 0; i < offered.size(); ++i) text += (i > 0 ? ", " : "") + offered[i];
   text += endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp ? "; default --tmcl-tcp 127.0.0.1:5000\n"
                                                                         : "; default --can socketcand:127.0.0.1:29536\n";
@@ -730,6 +731,8 @@ std::string modules_help() {
       for (const host::FirmwareGeneration& generation : module.firmwares) {
         text += "    " + std::string(generation.name) + " (" + std::string(generation.version) + "): " +
                 std::string(generation.help) + "\n";
+        // A generation that is another module to the host (another protocol): where it is served.
+        if (generation.descriptor != nullptr) text += endpoints_help(generation.descriptor().endpoints, "      ");
       }
     }
     text += endpoints_help(module.endpoints);
@@ -849,8 +852,8 @@ void add_serve_command(CLI::App& app, int& exit_status) {
       ->type_name("NAME|FILE")
       ->capture_default_str();
   serve->add_option("--firmware", arguments->firmware,
-                    "Firmware generation to emulate, for modules that have several (listed below); default: the "
-                    "module's first")
+                    "Firmware generation to emulate, for modules that have several (listed below, with the endpoints "
+                    "of one that speaks another protocol); default: the module's first")
       ->type_name("VERSION");
   serve->add_option("--scenario", arguments->scenario_path,
                     "Scenario file: lines \"<time_s> <SIGNAL> <value>\" (sim seconds), # comments")

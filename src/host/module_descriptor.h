@@ -94,14 +94,24 @@ struct CanopenDescription {
   CanopenDictionaryView (*dictionary)();
 };
 
+struct ModuleDescriptor;
+
 // One generation of a module's firmware that `--firmware` chooses (docs/host-runtime.md "Adding
-// a module"): the same module with another identity and row set, chosen when it is made.
+// a module"): the same module with another identity and row set, chosen when it is made, or a
+// firmware that speaks another protocol (the TMCM-1636's CANopen firmware beside its TMCL ones),
+// which brings the whole descriptor of the module running it.
 struct FirmwareGeneration {
   std::string_view name;     // as --firmware takes it: "1.13"
   std::string_view version;  // as `serve` prints it (command 136): "1636V113"
   std::string_view help;     // one line for `serve --help`
-  // `motwin params --firmware NAME`: this generation's parameters.
-  ModuleParameterListing (*listing)();
+  // `motwin params --firmware NAME`: this generation's parameters (unused with `descriptor`).
+  ModuleParameterListing (*listing)() = nullptr;
+  // A firmware with other endpoints, another protocol or another virtual module: the descriptor
+  // of the module running it (make, endpoints, canopen, listing, help, summary, firmware = version,
+  // motors, trace parameters). Its `name` is the module's, so `--module` still finds it; its
+  // make() is given ModuleOptions::firmware as the user wrote it (this generation's name) and
+  // need not read it. nullptr: the module's own descriptor with this identity and listing.
+  ModuleDescriptor (*descriptor)() = nullptr;
 };
 
 struct ModuleDescriptor {
@@ -154,11 +164,27 @@ inline Result<const FirmwareGeneration*> find_firmware(const ModuleDescriptor& m
                " (choices: " + firmware_names(module) + ")"};
 }
 
-// `motwin params`: the parameters of a module's firmware generation (NAME as find_firmware takes it).
+// The descriptor of `module` running the firmware `--firmware NAME` chooses (NAME as find_firmware
+// takes it, with its errors): a generation's own descriptor when it brings one, otherwise the
+// module with the generation's version string and listing (make() reads ModuleOptions::firmware).
+// A value, not a pointer: a generation's descriptor is built when asked for.
+inline Result<ModuleDescriptor> with_firmware(const ModuleDescriptor& module, std::string_view name) {
+  const Result<const FirmwareGeneration*> found = find_firmware(module, name);
+  if (!found) return Error{found.error()};
+  const FirmwareGeneration* generation = *found;
+  if (generation == nullptr) return module;
+  if (generation->descriptor != nullptr) return generation->descriptor();
+  ModuleDescriptor running = module;
+  running.firmware = generation->version;
+  if (generation->listing != nullptr) running.listing = generation->listing;
+  return running;
+}
+
+// `motwin params`: the parameters or objects of a module's firmware generation.
 inline Result<ModuleParameterListing> firmware_listing(const ModuleDescriptor& module, std::string_view name) {
-  const Result<const FirmwareGeneration*> generation = find_firmware(module, name);
-  if (!generation) return Error{generation.error()};
-  return *generation != nullptr ? (*generation)->listing() : module.listing();
+  const Result<ModuleDescriptor> running = with_firmware(module, name);
+  if (!running) return Error{running.error()};
+  return running->listing();
 }
 
 }  // namespace motwin::host

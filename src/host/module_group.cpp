@@ -77,7 +77,9 @@ Result<void> apply_node_key(std::string_view item, NodeSpec& spec) {
 Result<std::unique_ptr<VirtualModule>> make_member(const NodeSpec& spec,
                                                    const std::optional<std::filesystem::path>& state_dir,
                                                    const LogSink& log) {
-  if ((spec.boot_delay_ms || spec.communication_boot_delay_ms) && find_module(spec.module)->canopen == nullptr) {
+  const Result<ModuleDescriptor> descriptor = node_module(spec);
+  if (!descriptor) return Error{descriptor.error()};
+  if ((spec.boot_delay_ms || spec.communication_boot_delay_ms) && descriptor->canopen == nullptr) {
     return Error{"boot-delay-ms/comm-boot-delay-ms are for CANopen modules"};
   }
   ModuleOptions options;
@@ -89,7 +91,7 @@ Result<std::unique_ptr<VirtualModule>> make_member(const NodeSpec& spec,
   options.boot_delay_ms = spec.boot_delay_ms;
   options.communication_boot_delay_ms = spec.communication_boot_delay_ms;
   options.log = log;
-  MakeModuleResult made = make_module(spec.module, options);
+  MakeModuleResult made = descriptor->make(options);
   if (!made) return made;
   VirtualModule& module = **made;
   if (module.can_node() == nullptr) return Error{spec.module + " has no CAN interface"};
@@ -124,12 +126,11 @@ Result<NodeSpec> parse_node_spec(std::string_view text, size_t position) {
     rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
     if (const Result<void> applied = apply_node_key(item, spec); !applied) return Error{applied.error()};
   }
-  if (const Result<const FirmwareGeneration*> firmware = find_firmware(*find_module(spec.module), spec.firmware);
-      !firmware) {
-    return Error{firmware.error()};
-  }
+  if (const Result<ModuleDescriptor> descriptor = node_module(spec); !descriptor) return Error{descriptor.error()};
   return spec;
 }
+
+Result<ModuleDescriptor> node_module(const NodeSpec& spec) { return find_module_with_firmware(spec.module, spec.firmware); }
 
 Result<std::unique_ptr<ModuleGroup>> ModuleGroup::make(const std::vector<NodeSpec>& specs,
                                                        const std::optional<std::filesystem::path>& state_dir,

@@ -40,6 +40,10 @@ inline constexpr long kMaxBootDelayMs = 60'000;
 // or key, or a value out of range, is an error.
 Result<NodeSpec> parse_node_spec(std::string_view text, size_t position);
 
+// The descriptor of the module a node runs: its module with its firmware (with_firmware), which
+// may be another protocol's (a CANopen generation of a TMCL module).
+Result<ModuleDescriptor> node_module(const NodeSpec& spec);
+
 class ModuleGroup final : public VirtualModule {
  public:
   struct Member {

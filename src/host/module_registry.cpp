@@ -67,11 +67,17 @@ const ModuleDescriptor* first_module(bool (*keep)(const ModuleDescriptor&)) {
   return nullptr;
 }
 
-MakeModuleResult make_module(std::string_view name, const ModuleOptions& options) {
+Result<ModuleDescriptor> find_module_with_firmware(std::string_view name, std::string_view firmware) {
   const ModuleDescriptor* module = find_module(name);
   if (module == nullptr) {
     return Error{"unknown module \"" + std::string(name) + "\" (available: " + module_names() + ")"};
   }
+  return with_firmware(*module, firmware);
+}
+
+MakeModuleResult make_module(std::string_view name, const ModuleOptions& options) {
+  const Result<ModuleDescriptor> module = find_module_with_firmware(name, options.firmware);
+  if (!module) return Error{module.error()};
   return module->make(options);
 }
 

@@ -27,7 +27,12 @@ const ModuleDescriptor* first_module(bool (*keep)(const ModuleDescriptor&));
 inline bool has_tmcl(const ModuleDescriptor& module) { return module.endpoints.has_tmcl(); }
 inline bool has_canopen_dictionary(const ModuleDescriptor& module) { return module.canopen != nullptr; }
 
-// An unknown name or an unusable state directory gives an error, never an exception.
+// The descriptor of the module `name` running `firmware` (with_firmware; empty: its default), or
+// why there is none: an unknown module, naming the registered ones, or an unknown firmware.
+Result<ModuleDescriptor> find_module_with_firmware(std::string_view name, std::string_view firmware);
+
+// The module running options.firmware. An unknown name or firmware, or an unusable state
+// directory, gives an error, never an exception.
 MakeModuleResult make_module(std::string_view name, const ModuleOptions& options);
 
 }  // namespace motwin::host
