@@ -15,6 +15,7 @@
 #include <string_view>
 #include <vector>
 
+#include "board/can_controller.h"
 #include "core/canopen/object_dictionary.h"
 
 namespace motwin::host {
@@ -30,6 +31,7 @@ struct CanopenIdentity {
   uint8_t tpdo_count;
   std::span<const uint16_t> bit_rates_kbit;  // the bit rates the module supports
   bool lss_supported;                        // a CiA-305 LSS slave
+  bool dummy_mapping_supported;              // PDOs may map the dummy types 0002..0007
 };
 
 // One sub-index of one object.
@@ -52,6 +54,12 @@ struct DictionaryObject {
 
 struct CanopenDictionaryView {
   std::vector<DictionaryObject> objects;  // in index order
+};
+
+// A CAN controller that sends nowhere: for a device made only to read its dictionary.
+class NullCanController final : public board::CanController {
+ public:
+  bool transmit(const can::CanFrame&) override { return true; }
 };
 
 // The view of a module's dictionary as the device holding it stands (factory defaults after

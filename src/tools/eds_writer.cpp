@@ -78,7 +78,9 @@ void append_device_info(EdsText& eds, const CanopenIdentity& identity) {
   eds.line(fmt::format("LSS_Supported={}", identity.lss_supported ? 1 : 0));
   eds.line("");
   eds.line("[DummyUsage]");
-  for (int i = 1; i <= 7; ++i) eds.line(fmt::format("Dummy000{}={}", i, i >= 2 ? 1 : 0));
+  for (int i = 1; i <= 7; ++i) {
+    eds.line(fmt::format("Dummy000{}={}", i, i >= 2 && identity.dummy_mapping_supported ? 1 : 0));
+  }
   eds.line("");
   eds.line("[Comments]");
   eds.line("Lines=1");

@@ -232,7 +232,7 @@ CanopenDictionaryView fake_dictionary() {
 ModuleParameterListing fake_listing() { return canopen_object_listing("fake-2", fake_dictionary()); }
 
 constexpr uint16_t kFakeBitRates[] = {125, 1000};
-const CanopenDescription kFakeCanopen{{"FAKE-2", "Nobody", 0x1234, 2, 0x10000, 1, 2, kFakeBitRates, false},
+const CanopenDescription kFakeCanopen{{"FAKE-2", "Nobody", 0x1234, 2, 0x10000, 1, 2, kFakeBitRates, false, true},
                                       &fake_dictionary};
 
 ModuleDescriptor fake_descriptor() {

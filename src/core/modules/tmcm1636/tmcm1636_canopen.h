@@ -70,6 +70,23 @@ inline constexpr uint32_t kPositionEnd = 1u << 14;
 inline constexpr uint32_t kInitialized = 1u << 15;
 }  // namespace canopen_status_flag
 
+// The CANopen object bound to the same axis setting as a TMCL axis parameter (table 11 and the
+// 1.13 additions): where a preset's start-up settings, given as axis parameters, go in this
+// firmware's image (host/modules/tmcm1636/tmcm1636_startup_image.*).
+struct AxisParameterObject {
+  uint8_t axis_parameter;
+  uint16_t index;
+  uint8_t sub;
+};
+inline constexpr AxisParameterObject kAxisParameterObjects[] = {
+    {5, 0x2060, 3},   {6, 0x2060, 4},   {10, 0x2056, 0},  {11, 0x2003, 0},  {12, 0x2004, 0},  {13, 0x2057, 0},
+    {14, 0x2050, 0},  {15, 0x2055, 0},  {25, 0x2043, 3},  {26, 0x2042, 5},  {56, 0x2058, 0},  {70, 0x2041, 1},
+    {71, 0x2041, 2},  {72, 0x2042, 1},  {73, 0x2042, 2},  {74, 0x2043, 1},  {90, 0x2070, 1},  {91, 0x2070, 2},
+    {92, 0x2070, 3},  {93, 0x2070, 4},  {100, 0x2080, 2}, {101, 0x2080, 1}, {102, 0x2080, 3}, {140, 0x2006, 1},
+    {141, 0x2006, 2}, {142, 0x2006, 3}, {160, 0x2085, 1}, {161, 0x2085, 3}, {162, 0x2085, 2}, {163, 0x2085, 4},
+    {165, 0x2085, 5}, {166, 0x2085, 6}, {167, 0x2085, 7},
+};
+
 // The objects of the module that are neither the axis' settings nor the drive's.
 struct Tmcm1636CanopenObjects {
   uint32_t switch_parameters = kSwitchLeftUnused | kSwitchRightUnused;  // 2005 (EDS default 3)

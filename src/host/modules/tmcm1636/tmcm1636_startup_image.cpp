@@ -3,7 +3,9 @@
 #include <cmath>
 #include <optional>
 
+#include "core/canopen/storage.h"
 #include "core/modules/tmcm1636/tmcm1636.h"
+#include "core/modules/tmcm1636/tmcm1636_canopen.h"
 #include "core/tmcl/nvm_layout.h"
 
 namespace motwin::host {
@@ -147,6 +149,32 @@ void write_tmcm1636_startup_image(const MotorDescription& motor, uint8_t* image,
   for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(motor)) {
     if (!check_tmcm1636_axis_parameter(parameter.number, parameter.value)) continue;
     tmcl::put_le32(image + Tmcm1636::kNvmLayout.axis_parameter(0, parameter.number), parameter.value);
+  }
+}
+
+void write_tmcm1636_canopen_startup_image(const MotorDescription& motor, uint8_t* image, size_t size) {
+  using modules::tmcm1636::Tmcm1636Canopen;
+  if (!canopen::StorageImage::valid(image, size)) return;
+  size_t count = canopen::StorageImage::count(image);
+  for (const Tmcm1636StartupParameter& parameter : tmcm1636_startup_parameters(motor)) {
+    for (const modules::tmcm1636::AxisParameterObject& object : modules::tmcm1636::kAxisParameterObjects) {
+      if (object.axis_parameter != parameter.number) continue;
+      for (const auto& row : Tmcm1636Canopen::object_table()) {
+        const canopen::EntryInfo& info = row.info;
+        if (info.index != object.index || info.sub != object.sub) continue;
+        if (parameter.value < info.min || parameter.value > info.max) break;
+        if (canopen::StorageImage::size_for(count + 1) > size) return;
+        // A later value of the same object (a numbered one over a named one) replaces the record.
+        size_t slot = count;
+        for (size_t i = 0; i < count; ++i) {
+          const canopen::StorageRecord record = canopen::StorageImage::record(image, i);
+          if (record.index == object.index && record.sub == object.sub) slot = i;
+        }
+        canopen::StorageImage::put_record(image, slot, {object.index, object.sub, static_cast<uint32_t>(parameter.value)});
+        if (slot == count) canopen::StorageImage::set_count(image, ++count);
+        break;
+      }
+    }
   }
 }
 

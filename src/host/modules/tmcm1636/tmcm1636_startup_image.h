@@ -43,6 +43,11 @@ Result<sim::MotorChoice> resolve_tmcm1636_motor(std::string_view name_or_path);
 // defaults; a value the table refuses is skipped (resolve_tmcm1636_motor refuses such files).
 void write_tmcm1636_startup_image(const sim::MotorDescription& motor, uint8_t* image, size_t size);
 
+// The same for the CANopen firmware's image (an empty storage image): each value goes in as a stored
+// record of the object bound to the same setting (modules::tmcm1636::kAxisParameterObjects); an
+// axis parameter with no object, or a value the object refuses, is skipped.
+void write_tmcm1636_canopen_startup_image(const sim::MotorDescription& motor, uint8_t* image, size_t size);
+
 // Whether a TMCM-1636 image selects a motor (AP 14, motor type, is not 0).
 bool tmcm1636_image_configures_motor(const uint8_t* image, size_t size);
 

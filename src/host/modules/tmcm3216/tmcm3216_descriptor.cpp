@@ -16,17 +16,12 @@ namespace {
 
 using Device = modules::tmcm3216::Tmcm3216;
 
-class NullCan final : public board::CanController {
- public:
-  bool transmit(const can::CanFrame&) override { return true; }
-};
-
 // The firmware on a RAM image at factory defaults, powered up: the visible strings and the
 // table come from the real profile, as `serve` would answer them before any write.
 CanopenDictionaryView factory_dictionary() {
   auto nvm = std::make_unique<board::RamNonVolatileMemory<Device::kNvmSize>>();
   Device::format_factory_image(nvm->mutable_data(), nvm->size());
-  NullCan can;
+  NullCanController can;
   auto device = std::make_unique<Device>(*nvm, can);
   device->power_up();
   return view_of(device->dictionary());
@@ -47,7 +42,8 @@ const CanopenDescription kCanopen{
                  .rpdo_count = kPdos,
                  .tpdo_count = kPdos,
                  .bit_rates_kbit = kBitRatesKbit,
-                 .lss_supported = true},  // core/canopen/lss_slave.h
+                 .lss_supported = true,  // core/canopen/lss_slave.h
+                 .dummy_mapping_supported = true},
     .dictionary = &factory_dictionary,
 };
 
