@@ -175,7 +175,7 @@ TEST(CliParams, lists_the_rows_of_a_firmware_generation) {
   EXPECT_EQ(v109.output, run_motwin({"params", "--module", "tmcm-1636", "--format", "csv"}).output) << "1.09 is the default";
   const CompletedProcess unknown = run_motwin({"params", "--module", "tmcm-1636", "--firmware", "9.99"});
   EXPECT_EQ(unknown.exit_status, 2);
-  EXPECT_EQ(unknown.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13)\n");
+  EXPECT_EQ(unknown.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13, canopen)\n");
   const CompletedProcess one = run_motwin({"params", "--module", "tmcm-142", "--firmware", "1.13"});
   EXPECT_EQ(one.exit_status, 2);
   EXPECT_TRUE(contains(one.output, "tmcm-142 has one firmware")) << one.output;
@@ -184,7 +184,7 @@ TEST(CliParams, lists_the_rows_of_a_firmware_generation) {
 TEST(CliServe, unknown_firmware_is_refused_with_the_choices) {
   const CompletedProcess serve = run_motwin({"serve", "--firmware", "9.99", "--state-dir", "none"});
   EXPECT_EQ(serve.exit_status, 2);
-  EXPECT_EQ(serve.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13)\n");
+  EXPECT_EQ(serve.output, "motwin: error: unknown firmware \"9.99\" for tmcm-1636 (choices: 1.09, 1.13, canopen)\n");
   const CompletedProcess other = run_motwin({"serve", "--module", "tmcm-3216", "--firmware", "1.13", "--state-dir", "none"});
   EXPECT_EQ(other.exit_status, 2);
   EXPECT_TRUE(contains(other.output, "tmcm-3216 has one firmware")) << other.output;
