@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <vector>
 
 #include "core/modules/tmcm1636/tmcm1636_canopen.h"
 
@@ -97,28 +98,39 @@ std::pair<int64_t, bool> eds_default(const std::string& text) {
   return {parse_number(text), false};
 }
 
-// What differs from the EDS, and why (docs/tmcm-1636-canopen.md "Differences from the published EDS").
-enum class Field { kAccess, kDefault };
+// What differs from the EDS, and why: the table of docs/tmcm-1636-canopen.md "Differences from the
+// published EDS", rows `| object | sub | field | Motwin | EDS | why |`.
 struct Decision {
   uint16_t index;
   uint8_t sub;
-  Field field;
-  const char* why;
-};
-constexpr Decision kDecisions[] = {
-    {0x2041, 0, Field::kAccess, "sub 0 is the highest sub-index present, read-only (the EDS: rw)"},
-    {0x2041, 0, Field::kDefault, "sub 0 is 6, the highest sub-index present (the EDS: 1, though it lists 6)"},
-    {0x2043, 0, Field::kAccess, "sub 0 read-only (the EDS: rw)"},
-    {0x2060, 0, Field::kAccess, "sub 0 read-only (the EDS: rw)"},
-    {0x2056, 0, Field::kDefault, "pole pairs 4 (the EDS's 0 leaves the hall scaling without a divisor)"},
-    {0x2060, 3, Field::kDefault, "ADC offset mid-scale 32767 (the EDS's 0 reads mid-scale as a full-scale current)"},
-    {0x2060, 4, Field::kDefault, "ADC offset mid-scale 32767"},
-    {0x2080, 2, Field::kDefault, "encoder steps 8192 (the EDS's 0 leaves velocities without a unit)"},
+  std::string field;  // "access" or "default"
+  std::string motwin;
+  std::string eds;
 };
 
-bool decided(uint16_t index, uint8_t sub, Field field) {
-  for (const Decision& d : kDecisions) {
-    if (d.index == index && d.sub == sub && d.field == field) return true;
+std::vector<Decision> read_decisions() {
+  std::ifstream file(MOTWIN_SOURCE_DIR "/../docs/tmcm-1636-canopen.md");
+  EXPECT_TRUE(file);
+  std::vector<Decision> decisions;
+  std::string line;
+  bool in_section = false;
+  while (std::getline(file, line)) {
+    if (line.rfind("## ", 0) == 0) in_section = line == "## Differences from the published EDS";
+    if (!in_section || line.rfind("| ", 0) != 0) continue;
+    std::vector<std::string> cells;
+    std::istringstream row(line.substr(1));
+    std::string cell;
+    while (std::getline(row, cell, '|')) cells.push_back(trim(cell));
+    if (cells.size() < 6 || cells[0].empty() || !std::isxdigit(static_cast<unsigned char>(cells[0][0]))) continue;
+    decisions.push_back({static_cast<uint16_t>(std::stoul(cells[0], nullptr, 16)),
+                         static_cast<uint8_t>(std::stoul(cells[1])), cells[2], cells[3], cells[4]});
+  }
+  return decisions;
+}
+
+bool decided(const std::vector<Decision>& decisions, Key key, const std::string& field) {
+  for (const Decision& d : decisions) {
+    if (d.index == key.first && d.sub == key.second && d.field == field) return true;
   }
   return false;
 }
@@ -139,17 +151,18 @@ TEST(Tmcm1636CanopenEds, every_entry_of_the_published_eds_is_in_the_table_as_it_
   const auto eds = read_eds(MOTWIN_TEST_DATA_DIR "/TMCM-1636-CANopen_Hw1.1_Fw1.12.eds");
   ASSERT_GT(eds.size(), 200u);
   const auto rows = motwin_entries();
+  const std::vector<Decision> decisions = read_decisions();
   for (const auto& [key, entry] : eds) {
     const auto found = rows.find(key);
     ASSERT_NE(found, rows.end()) << where(key) << " " << entry.name << " is missing";
     const EntryInfo& info = *found->second;
     EXPECT_EQ(info.name, entry.name) << where(key);
     EXPECT_EQ(static_cast<int>(info.type), entry.data_type) << where(key) << " " << entry.name;
-    if (!decided(key.first, key.second, Field::kAccess)) {
+    if (!decided(decisions, key, "access")) {
       EXPECT_EQ(access_name(info.access), entry.access) << where(key) << " " << entry.name;
     }
     EXPECT_EQ(info.pdo_mappable, entry.pdo_mapping) << where(key) << " " << entry.name;
-    if (entry.default_value && !decided(key.first, key.second, Field::kDefault)) {
+    if (entry.default_value && !decided(decisions, key, "default")) {
       auto [value, plus_node_id] = eds_default(*entry.default_value);
       // A hexadecimal default of a signed type is its two's complement ("0x80000000" of an INTEGER32).
       const int bits = 8 * canopen::type_size(info.type);
@@ -167,20 +180,27 @@ TEST(Tmcm1636CanopenEds, the_table_has_no_entry_the_published_eds_lacks) {
   }
 }
 
-TEST(Tmcm1636CanopenEds, every_decision_is_a_real_difference) {
-  // A decision that no longer differs from the EDS is stale: drop it here and in the docs.
+TEST(Tmcm1636CanopenEds, every_decision_is_a_real_difference_with_the_values_the_docs_give) {
+  // A decision that no longer differs from the EDS is stale: drop it from the docs.
   const auto eds = read_eds(MOTWIN_TEST_DATA_DIR "/TMCM-1636-CANopen_Hw1.1_Fw1.12.eds");
   const auto rows = motwin_entries();
-  for (const Decision& d : kDecisions) {
+  const std::vector<Decision> decisions = read_decisions();
+  ASSERT_GE(decisions.size(), 5u) << "the docs' table was not found";
+  for (const Decision& d : decisions) {
     const Key key{d.index, d.sub};
     ASSERT_TRUE(eds.count(key) && rows.count(key)) << where(key);
     const EdsEntry& entry = eds.at(key);
     const EntryInfo& info = *rows.at(key);
-    if (d.field == Field::kAccess) {
-      EXPECT_NE(access_name(info.access), entry.access) << where(key) << ": " << d.why;
+    if (d.field == "access") {
+      EXPECT_EQ(access_name(info.access), d.motwin) << where(key);
+      EXPECT_EQ(entry.access, d.eds) << where(key);
+      EXPECT_NE(d.motwin, d.eds) << where(key);
     } else {
+      ASSERT_EQ(d.field, "default") << where(key);
       ASSERT_TRUE(entry.default_value.has_value()) << where(key);
-      EXPECT_NE(info.default_value, eds_default(*entry.default_value).first) << where(key) << ": " << d.why;
+      EXPECT_EQ(info.default_value, std::stoll(d.motwin, nullptr, 0)) << where(key);
+      EXPECT_EQ(eds_default(*entry.default_value).first, std::stoll(d.eds, nullptr, 0)) << where(key);
+      EXPECT_NE(info.default_value, eds_default(*entry.default_value).first) << where(key);
     }
   }
 }
