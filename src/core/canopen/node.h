@@ -45,6 +45,13 @@ inline constexpr size_t kNodeMaxPdos = PdoService::kMaxPdos;  // per direction
 inline constexpr uint32_t kSaveSignature = 0x6576'6173;      // "save" (1010, 2706)
 inline constexpr uint32_t kLoadSignature = 0x6461'6F6C;      // "load" (1011)
 
+// The restart times `motwin serve` gives a module whose manual gives none (NodeConfig): a Motwin
+// decision (docs/canopen.md "Start-up timing"). A reset node restarts the processor like a power-up
+// (bootloader, driver chips and the stored parameters set up again); a reset communication only
+// sets up the CANopen stack again.
+inline constexpr uint32_t kDefaultBootDelayUs = 300'000;
+inline constexpr uint32_t kDefaultCommunicationBootDelayUs = 50'000;
+
 // The communication objects a master writes (1005..1029, 1400..1A03), as the node's services
 // use them. A module declares the objects it has (communication_objects.h); the others keep
 // these values.
@@ -81,6 +88,8 @@ struct NodeIdentity {
 // One sub-index of 1010 (store) and of 1011 (restore): what a write with the signature selects.
 // Reading it gives 1 where the function is supported, 0 where a write is refused (08000020).
 struct StorageSubIndex {
+  std::string_view store_name;    // 1010's sub-index name
+  std::string_view restore_name;  // 1011's
   bool store_supported;
   StorageSelection store;
   bool restore_supported;
@@ -93,11 +102,11 @@ struct NodeDescription {
   uint8_t pdo_count;                          // per direction, at most kNodeMaxPdos
   std::span<const uint16_t> bit_rates_kbit;   // the bit rates the module supports (LSS, its objects)
   std::span<const StorageSubIndex> storage;   // 1010 / 1011 sub 1..n
-  uint16_t rpdo_value_emcy;                   // an RPDO value refused (TMCM-3216 table 365: 6320)
-  bool node_guarding;                         // answers guarding requests (100C/100D); else RTR is ignored
-  bool lss;                                   // a CiA-305 LSS slave; else LSS frames are ignored
   // Bytes 3..7 of the node's own EMCYs (communication errors, the RPDO value error).
-  uint8_t communication_emcy_data[5];
+  uint8_t communication_emcy_data[5] = {};
+  uint16_t rpdo_value_emcy = 0x6320;  // an RPDO value refused: CiA-402's "parameter error"
+  bool node_guarding = false;         // answers guarding requests (100C/100D); else RTR is ignored
+  bool lss = true;                    // a CiA-305 LSS slave; else LSS frames are ignored
 };
 
 // An instance's settings.

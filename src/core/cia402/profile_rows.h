@@ -209,8 +209,11 @@ SdoAbort check_homing_method(Owner&, uint8_t, int64_t v) {
 
 }  // namespace profile_rows
 
-template <class Owner, class Table>
-constexpr void add_profile_rows(Table& t, const ProfileRows& p) {
+// The profile area in index order. A module adds its own objects where they belong:
+// `after_quick_stop` after 6085 (the TMCM-3216's 608F), `before_target_velocity` after 60F2 (60FD).
+template <class Owner, class Table, class AfterQuickStop, class BeforeTargetVelocity>
+constexpr void add_profile_rows(Table& t, const ProfileRows& p, const AfterQuickStop& after_quick_stop,
+                                const BeforeTargetVelocity& before_target_velocity) {
   using namespace profile_rows;
   using enum DataType;
   using O = ProfileObjects;
@@ -303,21 +306,7 @@ constexpr void add_profile_rows(Table& t, const ProfileRows& p) {
   t.add(config_var<Owner, &O::profile_deceleration>(0x6084, p.profile_deceleration, s, kUnsigned32, 0, r::kU32Max));
   t.add(config_var<Owner, &O::quick_stop_deceleration>(0x6085, p.quick_stop_deceleration, s, kUnsigned32, 0,
                                                        r::kU32Max));
-}
-
-// The objects from 6098 on; a module adds its own rows between the two parts where its table
-// order wants them (the TMCM-3216's 608F).
-template <class Owner, class Table>
-constexpr void add_profile_rows_from_homing(Table& t, const ProfileRows& p) {
-  using namespace profile_rows;
-  using enum DataType;
-  using O = ProfileObjects;
-  namespace r = canopen::rows;
-  const uint16_t s = p.axis_stride;
-  constexpr int64_t kI8Min = -128;
-  constexpr int64_t kI8Max = 127;
-  constexpr int64_t kI16Min = -32768;
-  constexpr int64_t kI16Max = 32767;
+  after_quick_stop(t);
   t.add(config_var<Owner, &O::homing_method>(0x6098, p.homing_method, s, kInteger8, kI8Min, kI8Max,
                                              &check_homing_method<Owner>));
   t.add(array_head<Owner>(0x6099, ObjectCode::kArray, p.homing_speed_names, s));
@@ -339,17 +328,7 @@ constexpr void add_profile_rows_from_homing(Table& t, const ProfileRows& p) {
                                                      p.interpolation_names.second, s, kInteger8, -3, 3,
                                                      p.interpolation_index_default));
   t.add(config_var<Owner, &O::positioning_option>(0x60F2, p.positioning_option, s, kUnsigned16, 0, 2));
-}
-
-// 60FF, 6502, 67FF (after the module's 60FD).
-template <class Owner, class Table>
-constexpr void add_profile_rows_from_target_velocity(Table& t, const ProfileRows& p) {
-  using namespace profile_rows;
-  using enum DataType;
-  using O = ProfileObjects;
-  using Drive = DriveOf<Owner>;
-  namespace r = canopen::rows;
-  const uint16_t s = p.axis_stride;
+  before_target_velocity(t);
   t.add(set_point<Owner, &O::target_velocity, &Drive::target_velocity_written>(0x60FF, p.target_velocity, s,
                                                                               kInteger32, r::kI32Min, r::kI32Max));
   t.add(r::per_axis(r::var<Owner>(0x6502, p.supported_modes.name, kUnsigned32, Access::kRo, 0, r::kU32Max,

@@ -86,29 +86,28 @@ uint8_t Tmcm1636Canopen::application_error_register() const {
 }
 
 uint32_t Tmcm1636Canopen::status_flags() const {
-  namespace f = canopen_status_flag;
   const uint32_t axis = axis_.state.status_flags;
   uint32_t flags = 0;
-  if ((axis & status_flag::kUndervoltage) != 0) flags |= f::kUndervoltage;
-  if ((axis & status_flag::kOvervoltage) != 0) flags |= f::kOvervoltage;
-  if ((axis & status_flag::kOvertemperature) != 0) flags |= f::kOvertemperature;
-  if ((axis & status_flag::kHallError) != 0) flags |= f::kHallError;
-  if (axis_.state.actual_velocity_rpm == 0) flags |= f::kMotorHalted;
+  if ((axis & status_flag::kUndervoltage) != 0) flags |= kFlagUndervoltage;
+  if ((axis & status_flag::kOvervoltage) != 0) flags |= kFlagOvervoltage;
+  if ((axis & status_flag::kOvertemperature) != 0) flags |= kFlagOvertemperature;
+  if ((axis & status_flag::kHallError) != 0) flags |= kFlagHallError;
+  if (axis_.state.actual_velocity_rpm == 0) flags |= kFlagMotorHalted;
   if (!driver_enabled_) {
-    flags |= f::kStopMode;
+    flags |= kFlagStopMode;
   } else {
     switch (axis_.state.mode) {
-      case MotionMode::kVelocity: flags |= f::kVelocityMode; break;
-      case MotionMode::kPosition: flags |= f::kPositionMode; break;
-      case MotionMode::kTorque: flags |= f::kTorqueMode; break;
+      case MotionMode::kVelocity: flags |= kFlagVelocityMode; break;
+      case MotionMode::kPosition: flags |= kFlagPositionMode; break;
+      case MotionMode::kTorque: flags |= kFlagTorqueMode; break;
     }
   }
-  if (axis_.position_reached()) flags |= f::kPositionEnd;
+  if (axis_.position_reached()) flags |= kFlagPositionEnd;
   // Commutation set up: on, and for an ABN encoder its offset found.
   const CommutationMode commutation = axis_.config.commutation_mode;
   if (commutation != CommutationMode::kDisabled &&
       (commutation != CommutationMode::kAbnEncoder || axis_.encoder_initialised() || !axis_.has_power_stage())) {
-    flags |= f::kInitialized;
+    flags |= kFlagInitialized;
   }
   return flags;
 }
@@ -150,18 +149,18 @@ cia402::AxisInputs Tmcm1636Canopen::axis_inputs() const {
   inputs.encoder_position_usteps = drive_position(axis_.actual_position());
   inputs.actual_velocity_pps =
       static_cast<double>(directed(axis_.state.actual_velocity_rpm)) * axis_.config.position_scaler / 60.0;
-  // The switches' levels as the axis reads them (AP 210 polarity 0: high active), then 2005.
-  const uint32_t parameters = objects_.switch_parameters;
-  const bool left = (axis_.state.left_switch_active != 0) != ((parameters & kSwitchLeftInverted) != 0);
-  const bool right = (axis_.state.right_switch_active != 0) != ((parameters & kSwitchRightInverted) != 0);
-  const bool home = (axis_.state.home_switch_active != 0) != ((parameters & kSwitchHomeInverted) != 0);
-  // In the host's direction: with 2057 set the motor's left switch is the host's positive limit.
+  // The switches' levels as the axis reads them (AP 210 polarity 0: high active), then 2005, in the
+  // host's direction: with 2057 set the motor's right switch is the host's negative limit.
   const bool inverted = axis_.config.motor_direction != 0;
-  const bool negative = inverted ? right : left;
-  const bool positive = inverted ? left : right;
-  inputs.left_limit = negative && (parameters & (inverted ? kSwitchRightUnused : kSwitchLeftUnused)) == 0;
-  inputs.right_limit = positive && (parameters & (inverted ? kSwitchLeftUnused : kSwitchRightUnused)) == 0;
-  inputs.home_switch = home;
+  const bool motor_left = axis_.state.left_switch_active != 0;
+  const bool motor_right = axis_.state.right_switch_active != 0;
+  const cia402::Switches active =
+      cia402::active_switches(objects_.switch_parameters, {inverted ? motor_right : motor_left,
+                                                           inverted ? motor_left : motor_right,
+                                                           axis_.state.home_switch_active != 0});
+  inputs.left_limit = active.left;
+  inputs.right_limit = active.right;
+  inputs.home_switch = active.home;
   inputs.index_available = false;  // the index methods (1..14, 33, 34) are not this firmware's
   const uint32_t flags = axis_.state.status_flags;
   inputs.power_stage_fault =

@@ -19,6 +19,7 @@
 #include "board/non_volatile_memory.h"
 #include "core/canopen/node.h"
 #include "core/canopen/object_dictionary.h"
+#include "core/cia402/switch_parameters.h"
 #include "core/modules/tmcm1636/tmcm1636_axis.h"
 #include "core/modules/tmcm1636/tmcm1636_canopen_drive.h"
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
@@ -37,38 +38,48 @@ inline constexpr uint16_t kCanopenBitRatesKbit[] = {20, 50, 125, 250, 500, 800, 
 // manual's procedure), sub 3 application (the manufacturer objects: motor, sensors, regulators,
 // I/O), sub 4 axis 0 (its CiA-402 settings). docs/tmcm-1636-canopen.md "Storage".
 inline constexpr canopen::StorageSubIndex kCanopenStorage[] = {
-    {true, {.communication = true, .node_settings = true, .application = true, .axis_mask = 1}, true,
-     {.communication = true, .application = true, .axis_mask = 1}},
-    {true, {.communication = true, .node_settings = true}, true, {.communication = true}},
-    {true, {.application = true}, true, {.application = true}},
-    {true, {.axis_mask = 1}, true, {.axis_mask = 1}},
+    {.store_name = "Save all Parameters",
+     .restore_name = "Restore all Default Parameters",
+     .store_supported = true,
+     .store = {.communication = true, .node_settings = true, .application = true, .axis_mask = 1},
+     .restore_supported = true,
+     .restore = {.communication = true, .application = true, .axis_mask = 1}},
+    {.store_name = "Save Communication Parameters",
+     .restore_name = "Restore Communication Default Parameters",
+     .store_supported = true,
+     .store = {.communication = true, .node_settings = true},
+     .restore_supported = true,
+     .restore = {.communication = true}},
+    {.store_name = "Save Application Parameters",
+     .restore_name = "Restore Application Default Parameters",
+     .store_supported = true,
+     .store = {.application = true},
+     .restore_supported = true,
+     .restore = {.application = true}},
+    {.store_name = "Save Axis 0 Parameters",
+     .restore_name = "Restore Axis 0 Default Parameters",
+     .store_supported = true,
+     .store = {.axis_mask = 1},
+     .restore_supported = true,
+     .restore = {.axis_mask = 1}},
 };
-
-// 2005 Switch Parameters (the bit layout of the Trinamic CANopen firmwares, TMCM-3216 manual
-// 4.2.6): bit 0 / 1 left / right limit switch not used, bit 2 / 3 left / right inverted, bit 5
-// home switch inverted.
-inline constexpr uint32_t kSwitchLeftUnused = 1u << 0;
-inline constexpr uint32_t kSwitchRightUnused = 1u << 1;
-inline constexpr uint32_t kSwitchLeftInverted = 1u << 2;
-inline constexpr uint32_t kSwitchRightInverted = 1u << 3;
-inline constexpr uint32_t kSwitchHomeInverted = 1u << 5;
 
 // 2101 Status Flags, the layout PyTrinamic's TMCM-1636 CANopen example decodes (with the family's
 // other bits; docs/tmcm-1636-canopen.md "Status flags").
-namespace canopen_status_flag {
-inline constexpr uint32_t kOvercurrent = 1u << 0;
-inline constexpr uint32_t kUndervoltage = 1u << 1;
-inline constexpr uint32_t kOvervoltage = 1u << 2;
-inline constexpr uint32_t kOvertemperature = 1u << 3;
-inline constexpr uint32_t kMotorHalted = 1u << 4;
-inline constexpr uint32_t kHallError = 1u << 5;
-inline constexpr uint32_t kStopMode = 1u << 8;
-inline constexpr uint32_t kVelocityMode = 1u << 9;
-inline constexpr uint32_t kPositionMode = 1u << 10;
-inline constexpr uint32_t kTorqueMode = 1u << 11;
-inline constexpr uint32_t kPositionEnd = 1u << 14;
-inline constexpr uint32_t kInitialized = 1u << 15;
-}  // namespace canopen_status_flag
+enum CanopenStatusFlag : uint32_t {
+  kFlagOvercurrent = 1u << 0,
+  kFlagUndervoltage = 1u << 1,
+  kFlagOvervoltage = 1u << 2,
+  kFlagOvertemperature = 1u << 3,
+  kFlagMotorHalted = 1u << 4,
+  kFlagHallError = 1u << 5,
+  kFlagStopMode = 1u << 8,
+  kFlagVelocityMode = 1u << 9,
+  kFlagPositionMode = 1u << 10,
+  kFlagTorqueMode = 1u << 11,
+  kFlagPositionEnd = 1u << 14,
+  kFlagInitialized = 1u << 15,
+};
 
 // The CANopen object bound to the same axis setting as a TMCL axis parameter (table 11 and the
 // 1.13 additions): where a preset's start-up settings, given as axis parameters, go in this
@@ -89,7 +100,8 @@ inline constexpr AxisParameterObject kAxisParameterObjects[] = {
 
 // The objects of the module that are neither the axis' settings nor the drive's.
 struct Tmcm1636CanopenObjects {
-  uint32_t switch_parameters = kSwitchLeftUnused | kSwitchRightUnused;  // 2005 (EDS default 3)
+  // 2005 (cia402/switch_parameters.h; the EDS's default 3: neither limit switch used).
+  uint32_t switch_parameters = cia402::switch_parameter::kLeftDisabled | cia402::switch_parameter::kRightDisabled;
   uint32_t outputs = 0;      // 2703 sub 1: bit n drives GPO n
   uint32_t output_mask = 0;  // 2703 sub 2: which bits a write of sub 1 changes
 };
@@ -111,24 +123,21 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   static constexpr uint32_t kProductCode = 0x664;  // 1636
   static constexpr uint32_t kRevisionNumber = 0x0001'000C;
 
+  // Node guarding (100C / 100D), no LSS (the EDS's LSS_Supported=0); the EMCY bytes as the
+  // family's (byte 4 = 255 for the communication errors, TMCM-1690 manual).
+  static constexpr canopen::NodeDescription kNode{.identity = {kVendorId, kProductCode, kRevisionNumber},
+                                                  .pdo_count = kCanopenPdoCount,
+                                                  .bit_rates_kbit = kCanopenBitRatesKbit,
+                                                  .storage = kCanopenStorage,
+                                                  .communication_emcy_data = {0, 255, 0, 0, 0},
+                                                  .node_guarding = true,
+                                                  .lss = false};
+  // The restart times `motwin serve` gives the module unless told otherwise (no source gives the
+  // TMCM-1636's), and its storage image.
+  static constexpr uint32_t kBootDelayUs = canopen::kDefaultBootDelayUs;
+  static constexpr uint32_t kCommunicationBootDelayUs = canopen::kDefaultCommunicationBootDelayUs;
   static constexpr uint32_t kNvmLayoutVersion = 1;
-  static constexpr size_t kNvmRecordCapacity = 512;
-  static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
-  // The restart times `motwin serve` gives the module unless told otherwise: the TMCM-3216's
-  // (docs/canopen.md "Start-up timing"); no source gives the TMCM-1636's.
-  static constexpr uint32_t kBootDelayUs = 300'000;
-  static constexpr uint32_t kCommunicationBootDelayUs = 50'000;
-
-  static constexpr canopen::NodeDescription kNode{
-      .identity = {kVendorId, kProductCode, kRevisionNumber},
-      .pdo_count = kCanopenPdoCount,
-      .bit_rates_kbit = kCanopenBitRatesKbit,
-      .storage = kCanopenStorage,
-      .rpdo_value_emcy = 0x6320,  // the family's "parameter error" (TMCM-3216 table 365, TMCM-1690)
-      .node_guarding = true,      // 100C / 100D
-      .lss = false,               // the EDS's LSS_Supported=0
-      .communication_emcy_data = {0, 255, 0, 0, 0},
-  };
+  static constexpr size_t kNvmSize = canopen::StorageImage::size_for(512);
 
   // Every object of the dictionary (tmcm1636_canopen_objects.cpp).
   static std::span<const Row> object_table();

@@ -41,11 +41,6 @@ constexpr Row count_entry(uint16_t index, ObjectCode code, std::string_view obje
   return row;
 }
 
-constexpr Row string_var(uint16_t index, std::string_view name, std::string_view (*get)(Module&, uint8_t)) {
-  Binding binding;
-  binding.get_string = get;
-  return r::var<Module>(index, name, kVisibleString, Access::kConst, 0, 0, 0, binding);
-}
 
 constexpr Row stored(Row row, StorageGroup group) {
   row.info.storage = group;
@@ -115,12 +110,6 @@ constexpr uint32_t kBootModeKey = 0x1234'5678;
 
 // --- The communication objects -------------------------------------------------------------------
 
-constexpr std::string_view kStoreNames[] = {"Save all Parameters", "Save Communication Parameters",
-                                            "Save Application Parameters", "Save Axis 0 Parameters"};
-constexpr std::string_view kRestoreNames[] = {"Restore all Default Parameters", "Restore Communication Default Parameters",
-                                              "Restore Application Default Parameters",
-                                              "Restore Axis 0 Default Parameters"};
-
 // RPDO COB-IDs carry bit 30 (no RTR), as the EDS gives them; TPDO 3 goes out at every SYNC,
 // TPDO 4 when its values change (docs/tmcm-1636-canopen.md "Event-driven TPDOs").
 constexpr canopen::PdoObjects kPdoObjects{
@@ -138,23 +127,7 @@ constexpr canopen::PdoObjects kPdoObjects{
              {0x280, 0xFF, 2, {0x6041'0010, 0x6061'0008}},
              {0x380, 0x01, 2, {0x6041'0010, 0x6064'0020}},
              {0x480, 0xFE, 2, {0x6041'0010, 0x606C'0020}}},
-    .rpdo_communication = {"Receive PDO Communication Parameter 1", "Receive PDO Communication Parameter 2",
-                           "Receive PDO Communication Parameter 3", "Receive PDO Communication Parameter 4"},
-    .rpdo_mapping = {"Receive PDO Mapping Parameter 1", "Receive PDO Mapping Parameter 2",
-                     "Receive PDO Mapping Parameter 3", "Receive PDO Mapping Parameter 4"},
-    .tpdo_communication = {"Transmit PDO Communication Parameter 1", "Transmit PDO Communication Parameter 2",
-                           "Transmit PDO Communication Parameter 3", "Transmit PDO Communication Parameter 4"},
-    .tpdo_mapping = {"Transmit PDO Mapping Parameter 1", "Transmit PDO Mapping Parameter 2",
-                     "Transmit PDO Mapping Parameter 3", "Transmit PDO Mapping Parameter 4"},
-    .communication_count = "Highest sub-index supported",
-    .rpdo_cob_id = "COB-ID",
-    .tpdo_cob_id = "COB-ID",
-    .transmission_type = "Transmission Type",
-    .inhibit_time = "Inhibit Time",
-    .compatibility = "Compatibility Entry",
-    .event_timer = "Event Timer",
-    .mapping_count = "Number of mapped objects",
-    .mapping_entry = {"Mapping Entry 1", "Mapping Entry 2", "Mapping Entry 3"},
+    .names = &canopen::kPdoNamesDesignTool,
 };
 
 // --- The CiA-402 objects -------------------------------------------------------------------------
@@ -212,31 +185,18 @@ constexpr cia402::ProfileRows kProfileRows{
 
 // --- The table -----------------------------------------------------------------------------------
 
+// No 1006 (the EDS's module is a SYNC consumer only), node guarding, 1014 read-only, 1029 sub 1 only.
+constexpr canopen::CommunicationObjects kCommunication{
+    .names = &canopen::kCommunicationNamesDesignTool,
+    .pdos = &kPdoObjects,
+    .sync_producer = false,
+    .node_guarding = true,
+    .emcy_cob_id_access = Access::kRo,
+    .application_error_behavior = false,
+};
+
 constexpr size_t kCapacity = 260;
 using Table = canopen::RowTable<Module, kCapacity>;
-
-constexpr void add_communication_rows(Table& t) {
-  t.add(r::var<Module>(0x1000, "Device Type", kUnsigned32, Access::kConst, 0, r::kU32Max, Module::kDeviceType));
-  canopen::add_error_register_row<Module>(t, "Error Register");
-  // No 1006: the EDS's module is a SYNC consumer only, so 1005 bit 30 has no period to produce with.
-  canopen::add_sync_rows<Module>(t, "COB-ID SYNC", "");
-  t.add(string_var(0x1008, "Manufacturer Device Name", [](Module&, uint8_t) { return Module::kDeviceName; }));
-  t.add(string_var(0x1009, "Manufacturer Hardware Version", [](Module&, uint8_t) { return Module::kHardwareVersion; }));
-  t.add(string_var(0x100A, "Manufacturer Software Version", [](Module&, uint8_t) { return Module::kSoftwareVersion; }));
-  canopen::add_node_guarding_rows<Module>(t, "Guard Time", "Life Time Factor");
-  canopen::add_storage_rows<Module>(t, "Store Parameter Field", kStoreNames, "Restore Default Parameters",
-                                    kRestoreNames, kCanopenStorage);
-  canopen::add_emergency_rows<Module>(t, "COB-ID EMCY", "Inhibit Time Emergency", Access::kRo);
-  canopen::add_heartbeat_rows<Module>(t, "Heartbeat Consumer Entries", "Highest sub-index supported",
-                                      "Consumer Heartbeat Time 1", "Producer Heartbeat Time");
-  canopen::add_identity_rows<Module>(t,
-                                     {"Identity Object", "number of entries", "Vendor Id", "Product Code",
-                                      "Revision number", "Serial number"},
-                                     Module::kNode.identity);
-  canopen::add_error_behavior_rows<Module>(t, "Error Behaviour", "Highest sub-index supported", "Communication Error",
-                                           "");
-  canopen::add_pdo_rows<Module, Table, kPdoObjects>(t);
-}
 
 constexpr void add_motor_rows(Table& t) {
   using C = AxisConfig;
@@ -426,26 +386,29 @@ constexpr void add_device_rows(Table& t) {
 }
 
 constexpr void add_drive_rows(Table& t) {
-  cia402::add_profile_rows<Module>(t, kProfileRows);
-  cia402::add_profile_rows_from_homing<Module>(t, kProfileRows);
-  // 6074 / 6077: the current regulator's target and actual torque (AP 30, 31), in the host's
-  // direction.
-  t.add(r::mappable(r::var<Module>(0x6077, "Torque Actual Value", kInteger16, Access::kRo, kI16Min, kI16Max, 0,
-                                   r::getter<Module>([](Module& m, uint8_t) -> int64_t {
-                                     return m.directed(m.axis().state.actual_torque_ma);
-                                   }))));
-  t.add(r::var<Module>(0x6074, "Torque Demand Value", kInteger16, Access::kRo, kI16Min, kI16Max, 0,
-                       r::getter<Module>([](Module& m, uint8_t) -> int64_t {
-                         return m.directed(m.axis().state.target_torque_ma);
-                       })));
-  t.add(r::mappable(r::var<Module>(0x60FD, "Digital Inputs", kUnsigned32, Access::kRo, 0, r::kU32Max, 0,
-                                   r::getter<Module>([](Module& m, uint8_t) -> int64_t { return m.digital_inputs(); }))));
-  cia402::add_profile_rows_from_target_velocity<Module>(t, kProfileRows);
+  cia402::add_profile_rows<Module>(
+      t, kProfileRows, [](Table&) {},
+      [](Table& rows) {
+        // 6074 / 6077: the current regulator's target and actual torque (AP 30, 31), in the host's
+        // direction; 60FD.
+        rows.add(r::mappable(r::var<Module>(0x6077, "Torque Actual Value", kInteger16, Access::kRo, kI16Min, kI16Max, 0,
+                                            r::getter<Module>([](Module& m, uint8_t) -> int64_t {
+                                              return m.directed(m.axis().state.actual_torque_ma);
+                                            }))));
+        rows.add(r::var<Module>(0x6074, "Torque Demand Value", kInteger16, Access::kRo, kI16Min, kI16Max, 0,
+                                r::getter<Module>([](Module& m, uint8_t) -> int64_t {
+                                  return m.directed(m.axis().state.target_torque_ma);
+                                })));
+        rows.add(r::mappable(r::var<Module>(0x60FD, "Digital Inputs", kUnsigned32, Access::kRo, 0, r::kU32Max, 0,
+                                            r::getter<Module>([](Module& m, uint8_t) -> int64_t {
+                                              return m.digital_inputs();
+                                            }))));
+      });
 }
 
 constexpr Table build_table() {
   Table t;
-  add_communication_rows(t);
+  canopen::add_communication_rows<Module, Table, kCommunication>(t);
   add_motor_rows(t);
   add_device_rows(t);
   add_drive_rows(t);

@@ -57,13 +57,14 @@ inline constexpr uint16_t kBitRatesKbit[] = {20, 50, 100, 125, 250, 500, 800, 10
 // function", manual 3.1.8), sub 3 device profile parameters "not used", subs 4..6 motor n.
 inline constexpr uint8_t kAllAxesMask = (1u << kAxisCount) - 1;
 inline constexpr canopen::StorageSubIndex kStorageSubIndices[] = {
-    {true, {.communication = true, .node_settings = true, .axis_mask = kAllAxesMask}, true,
+    {"Save all parameters", "Restore all parameters", true,
+     {.communication = true, .node_settings = true, .axis_mask = kAllAxesMask}, true,
      {.communication = true, .axis_mask = kAllAxesMask}},
-    {true, {.node_settings = true}, true, {}},
-    {false, {}, false, {}},
-    {true, {.axis_mask = 1}, true, {.axis_mask = 1}},
-    {true, {.axis_mask = 2}, true, {.axis_mask = 2}},
-    {true, {.axis_mask = 4}, true, {.axis_mask = 4}},
+    {"Save communication parameters", "Restore communication parameters", true, {.node_settings = true}, true, {}},
+    {"Save device profile parameters", "Restore device profile parameters", false, {}, false, {}},
+    {"Save motor 0 parameters", "Restore motor 0 parameters", true, {.axis_mask = 1}, true, {.axis_mask = 1}},
+    {"Save motor 1 parameters", "Restore motor 1 parameters", true, {.axis_mask = 2}, true, {.axis_mask = 2}},
+    {"Save motor 2 parameters", "Restore motor 2 parameters", true, {.axis_mask = 4}, true, {.axis_mask = 4}},
 };
 
 class Tmcm3216 final : private canopen::NodeApplication {
@@ -89,25 +90,20 @@ class Tmcm3216 final : private canopen::NodeApplication {
   static constexpr size_t kNvmRecordCapacity = 1024;
   static constexpr size_t kNvmSize = canopen::StorageImage::size_for(kNvmRecordCapacity);
   static constexpr size_t kReceiveQueueLength = canopen::Node::kReceiveQueueLength;
-  // The restart times `motwin serve` gives the module unless told otherwise (Tmcm3216Config).
-  // The manual gives none: a Motwin decision (docs/canopen.md "Start-up timing"). A reset node
-  // restarts the processor like a power-up (bootloader, three driver chips and the stored
-  // parameters set up again); a reset communication only sets up the CANopen stack again.
-  static constexpr uint32_t kBootDelayUs = 300'000;
-  static constexpr uint32_t kCommunicationBootDelayUs = 50'000;
+  // The restart times `motwin serve` gives the module unless told otherwise (Tmcm3216Config); the
+  // manual gives none.
+  static constexpr uint32_t kBootDelayUs = canopen::kDefaultBootDelayUs;
+  static constexpr uint32_t kCommunicationBootDelayUs = canopen::kDefaultCommunicationBootDelayUs;
 
-  // What the node knows of the firmware: identity, PDOs, bit rates, storage.
-  static constexpr canopen::NodeDescription kNode{
-      .identity = {kVendorId, kProductCode, kRevisionNumber},
-      .pdo_count = kPdoCount,
-      .bit_rates_kbit = kBitRatesKbit,
-      .storage = kStorageSubIndices,
-      .rpdo_value_emcy = kEmcyPdoParameter,
-      .node_guarding = false,  // manual 1.1: RTR frames are not answered
-      .lss = true,
-      // Manual table 365: byte 2 is the motor, 255 for the communication errors.
-      .communication_emcy_data = {0, 255, 0, 0, 0},
-  };
+  // What the node knows of the firmware: identity, PDOs, bit rates, storage, and the EMCY bytes of
+  // table 365 (byte 2 the motor, 255 for the communication errors; 6320 for a refused RPDO value).
+  // An LSS slave; no node guarding (manual 1.1: RTR frames are not answered).
+  static constexpr canopen::NodeDescription kNode{.identity = {kVendorId, kProductCode, kRevisionNumber},
+                                                  .pdo_count = kPdoCount,
+                                                  .bit_rates_kbit = kBitRatesKbit,
+                                                  .storage = kStorageSubIndices,
+                                                  .communication_emcy_data = {0, 255, 0, 0, 0}};
+  static_assert(kNode.rpdo_value_emcy == kEmcyPdoParameter);
   // Every object of the dictionary (tmcm3216_objects.cpp).
   static std::span<const Row> object_table();
   // An image with nothing stored: every object at its default.

@@ -40,21 +40,9 @@ constexpr Row var(uint16_t index, std::string_view name, DataType type, Access a
   return row(index, 0, ObjectCode::kVar, name, name, type, access, min, max, default_value, binding, storage);
 }
 
-constexpr Row string_var(uint16_t index, std::string_view name, std::string_view (*get)(Tmcm3216&, uint8_t)) {
-  Binding binding;
-  binding.get_string = get;
-  return row(index, 0, ObjectCode::kVar, name, name, DataType::kVisibleString, Access::kConst, 0, 0, 0, binding);
-}
 
 // --- The communication objects (manual chapter 3), on the node -----------------------------------
 
-// 1010 / 1011 sub-index names (tables 23, 26); what each selects is Tmcm3216::kNode's.
-constexpr std::string_view kStoreNames[] = {"Save all parameters",       "Save communication parameters",
-                                            "Save device profile parameters", "Save motor 0 parameters",
-                                            "Save motor 1 parameters",   "Save motor 2 parameters"};
-constexpr std::string_view kRestoreNames[] = {
-    "Restore all parameters",   "Restore communication parameters", "Restore device profile parameters",
-    "Restore motor 0 parameters", "Restore motor 1 parameters",     "Restore motor 2 parameters"};
 // Tables 41, 43, 45, 47 (axis 0). Axes 1 and 2: the manual gives defaults for axis 0 only. Their
 // PDOs start not valid (bit 31) with axis 0's identifiers, so that nothing collides until a
 // master configures them, and their mappings name the same objects of their own axis (+ 0x800 per
@@ -74,26 +62,21 @@ constexpr canopen::PdoObjects kPdoObjects{
              {0x280, 0xFF, 2, {0x6041'0010, 0x6061'0008}},
              {0x380, 0x01, 2, {0x6041'0010, 0x6064'0020}},
              {0x480, 0x01, 2, {0x6041'0010, 0x606C'0020}}},
-    .rpdo_communication = {"RPDO 1 communication parameter", "RPDO 2 communication parameter",
-                           "RPDO 3 communication parameter", "RPDO 4 communication parameter"},
-    .rpdo_mapping = {"RPDO 1 mapping parameter", "RPDO 2 mapping parameter", "RPDO 3 mapping parameter",
-                     "RPDO 4 mapping parameter"},
-    .tpdo_communication = {"TPDO 1 communication parameter", "TPDO 2 communication parameter",
-                           "TPDO 3 communication parameter", "TPDO 4 communication parameter"},
-    .tpdo_mapping = {"TPDO 1 mapping parameter", "TPDO 2 mapping parameter", "TPDO 3 mapping parameter",
-                     "TPDO 4 mapping parameter"},
-    .communication_count = "Highest sub-index supported",
-    .rpdo_cob_id = "COB-ID used by RPDO",
-    .tpdo_cob_id = "COB-ID used by TPDO",
-    .transmission_type = "Transmission type",
-    .inhibit_time = "Inhibit time",
-    .compatibility = "Compatibility entry",
-    .event_timer = "Event timer",
-    .mapping_count = "Number of mapped application objects in PDO",
-    .mapping_entry = {"Mapping entry 1", "Mapping entry 2", "Mapping entry 3"},
+    .names = &canopen::kPdoNamesCia301,
 };
 
 // --- The table ------------------------------------------------------------------------------------
+
+// Chapter 3: SYNC producer as a Motwin extension (1006), no node guarding (manual 1.1: RTR frames
+// are not answered).
+constexpr canopen::CommunicationObjects kCommunication{
+    .names = &canopen::kCommunicationNamesCia301,
+    .pdos = &kPdoObjects,
+    .sync_producer = true,
+    .node_guarding = false,
+    .emcy_cob_id_access = Access::kRw,
+    .application_error_behavior = true,
+};
 
 constexpr size_t kCapacity = 360;
 using Table = canopen::RowTable<Tmcm3216, kCapacity>;
@@ -103,28 +86,9 @@ constexpr Table build_table() {
   using enum DataType;
   constexpr StorageGroup kNode = StorageGroup::kNodeSettings;
   Table t;
-  t.add(var(0x1000, "Device type", kUnsigned32, Access::kConst, 0, kU32Max, Tmcm3216::kDeviceType));
-  canopen::add_error_register_row<Tmcm3216>(t, "Error register");
-  canopen::add_sync_rows<Tmcm3216>(t, "COB-ID SYNC", "Communication cycle period");
-  t.add(string_var(0x1008, "Manufacturer device name", [](Tmcm3216&, uint8_t) { return Tmcm3216::kDeviceName; }));
-  t.add(string_var(0x1009, "Manufacturer hardware version",
-                   [](Tmcm3216&, uint8_t) { return Tmcm3216::kHardwareVersion; }));
-  t.add(string_var(0x100A, "Manufacturer software version",
-                   [](Tmcm3216&, uint8_t) { return Tmcm3216::kSoftwareVersion; }));
-  canopen::add_storage_rows<Tmcm3216>(t, "Store parameters", kStoreNames, "Restore default parameters", kRestoreNames,
-                                      kStorageSubIndices);
-  canopen::add_emergency_rows<Tmcm3216>(t, "COB-ID EMCY", "Inhibit time EMCY");
-  canopen::add_heartbeat_rows<Tmcm3216>(t, "Consumer heartbeat time", "Number of entries", "Consumer heartbeat time 1",
-                                        "Producer heartbeat time");
-  // 1018 (table 37): sub 0 is 4, the highest sub-index present (the table prints 3 but lists 4).
-  canopen::add_identity_rows<Tmcm3216>(t,
-                                       {"Identity object", "Number of entries", "Vendor-ID", "Product code",
-                                        "Revision number", "Serial number"},
-                                       Tmcm3216::kNode.identity);
-  // 1029 (table 39): 0 stopped... as the manual words it; CiA-301 values 0..2.
-  canopen::add_error_behavior_rows<Tmcm3216>(t, "Error behavior", "Number of error classes", "Communication error",
-                                             "Application error");
-  canopen::add_pdo_rows<Tmcm3216, Table, kPdoObjects>(t);
+  // Chapter 3. 1018 (table 37): sub 0 is 4, the highest sub-index present (the table prints 3 but
+  // lists 4). 1029 (table 39): 0 stopped... as the manual words it; CiA-301 values 0..2.
+  canopen::add_communication_rows<Tmcm3216, Table, kCommunication>(t);
   // Node ID and bit rate (4.2.62-4.2.66).
   t.add(var(0x2704, "CAN bit rate", kUnsigned16, Access::kRw, 20, 1000, 1000, canopen::node_bit_rate_binding<Tmcm3216>(),
             kNode));

@@ -125,22 +125,24 @@ constexpr void add_profile_rows(Table& t) {
   using canopen::ObjectCode;
   namespace r = canopen::rows;
   constexpr uint16_t kStride = kProfileAxisStride;
-  cia402::add_profile_rows<Owner>(t, kProfileRows);
-  // 608F: sub 1 is the stepper's (it scales the encoder), sub 2 is 1.
-  t.add(r::per_axis(r::highest_sub<Owner>(0x608F, ObjectCode::kArray, "Position encoder resolution", 2), kStride));
-  t.add(cia402::profile_rows::axis_row(
-      r::row<Owner>(0x608F, 1, ObjectCode::kArray, "Position encoder resolution", "Encoder increments",
-                    DataType::kUnsigned32, Access::kRw, 0, r::kI32Max, 1,
-                    canopen::field_binding<Owner, [](Owner& d, uint8_t a) -> uint32_t& {
-                      return d.stepper(a).objects.encoder_increments;
-                    }>()),
-      kStride, false, true));
-  t.add(r::per_axis(r::row<Owner>(0x608F, 2, ObjectCode::kArray, "Position encoder resolution", "Motor revolutions",
-                                  DataType::kUnsigned32, Access::kRo, 1, 1, 1),
-                    kStride));
-  cia402::add_profile_rows_from_homing<Owner>(t, kProfileRows);
-  add_digital_inputs_row<Owner>(t);  // 60FD (the stepper's rows)
-  cia402::add_profile_rows_from_target_velocity<Owner>(t, kProfileRows);
+  cia402::add_profile_rows<Owner>(
+      t, kProfileRows,
+      [](Table& rows) {
+        // 608F: sub 1 is the stepper's (it scales the encoder), sub 2 is 1.
+        rows.add(r::per_axis(r::highest_sub<Owner>(0x608F, ObjectCode::kArray, "Position encoder resolution", 2),
+                             kStride));
+        rows.add(cia402::profile_rows::axis_row(
+            r::row<Owner>(0x608F, 1, ObjectCode::kArray, "Position encoder resolution", "Encoder increments",
+                          DataType::kUnsigned32, Access::kRw, 0, r::kI32Max, 1,
+                          canopen::field_binding<Owner, [](Owner& d, uint8_t a) -> uint32_t& {
+                            return d.stepper(a).objects.encoder_increments;
+                          }>()),
+            kStride, false, true));
+        rows.add(r::per_axis(r::row<Owner>(0x608F, 2, ObjectCode::kArray, "Position encoder resolution",
+                                           "Motor revolutions", DataType::kUnsigned32, Access::kRo, 1, 1, 1),
+                             kStride));
+      },
+      [](Table& rows) { add_digital_inputs_row<Owner>(rows); });  // 60FD (the stepper's rows)
 }
 
 // 2010..2018 (EightPoint ramp), 208C/208E (units), 2100 (home offset display); + n x 0x200.

@@ -126,14 +126,12 @@ void Tmcm3216Stepper::tick(board::StepperPowerStage& stage, const StepperDemand&
 // 2005: bit 0 right, 1 left, 2 home in the electrical levels; a level set = switch active unless
 // inverted; a disabled switch reads inactive.
 void Tmcm3216Stepper::read_switches(uint8_t levels) {
-  const uint32_t c = objects.switch_config;
-  const bool right = ((levels & 1u) != 0) != ((c & switch_bits::kRightInverted) != 0);
-  const bool left = ((levels & 2u) != 0) != ((c & switch_bits::kLeftInverted) != 0);
-  const bool home = ((levels & 4u) != 0) != ((c & switch_bits::kHomeInverted) != 0);
+  const cia402::Switches active = cia402::active_switches(
+      objects.switch_config, cia402::Switches{(levels & 2u) != 0, (levels & 1u) != 0, (levels & 4u) != 0});
   switches_.raw = static_cast<uint8_t>(levels & 7u);
-  switches_.right = right && (c & switch_bits::kRightDisabled) == 0;
-  switches_.left = left && (c & switch_bits::kLeftDisabled) == 0;
-  switches_.home = home && (c & switch_bits::kHomeDisabled) == 0;
+  switches_.right = active.right;
+  switches_.left = active.left;
+  switches_.home = active.home;
 }
 
 void Tmcm3216Stepper::read_encoder(const board::StepperFeedback& feedback, int32_t demand_position) {

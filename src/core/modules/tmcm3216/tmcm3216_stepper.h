@@ -19,6 +19,7 @@
 #include <cstdint>
 
 #include "board/stepper_drive.h"
+#include "core/cia402/switch_parameters.h"
 #include "core/motion/coolstep.h"
 #include "core/motion/stall_detector.h"
 
@@ -41,14 +42,7 @@ constexpr bool stall_reaction_of(uint8_t option_code, motion::StallReaction& out
 }
 
 // 2005 bits (manual table 62).
-namespace switch_bits {
-inline constexpr uint32_t kLeftDisabled = 1u << 0;
-inline constexpr uint32_t kRightDisabled = 1u << 1;
-inline constexpr uint32_t kLeftInverted = 1u << 2;
-inline constexpr uint32_t kRightInverted = 1u << 3;
-inline constexpr uint32_t kHomeDisabled = 1u << 4;
-inline constexpr uint32_t kHomeInverted = 1u << 5;
-}  // namespace switch_bits
+namespace switch_bits = cia402::switch_parameter;
 
 // The per-axis objects (axis n at index + n x 0x200), with the manual's defaults. Stored with
 // 1010 sub 4 + n. Velocity objects hold the written value: pps, or chip units while 208C = 0
