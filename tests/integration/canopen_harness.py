@@ -146,6 +146,17 @@ class CanopenClient:
         self._marker(node, predicate, frames)
         return frames
 
+    def frames_seen_by(self, listener, node, predicate=lambda msg: True):
+        """frames_until_marker() as `listener`, a socketcand client on the same bus, sees them:
+        this client's own frames among them, with the bus times they were taken in. This client
+        sends the marker and reads up to its answer too, so that the answer is not taken for the
+        reply to a later SDO request of either client."""
+        check(listener.stamps_simulated_time, "bus times need a socketcand listener")
+        frames = []
+        answer = self._marker(node)
+        listener._follow_marker(node, answer, predicate, frames)
+        return frames
+
     def _marker(self, node, predicate=None, frames=None):
         """Sends a new marker to `node` and reads up to its answer (see _up_to_marker_answer)."""
         sub = 1 + next(_marker_numbers) % 255
