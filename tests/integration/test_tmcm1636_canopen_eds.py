@@ -203,7 +203,8 @@ def test_every_listed_difference_is_real_with_the_values_the_docs_give(motwin):
         field = row["field"]
         check(field in theirs and field in ours, f"{row['line']}: {field} missing in one of the EDS files")
         if field == "DefaultValue":
-            documented_ours, documented_theirs = resolve_default(ours, row["motwin"]), resolve_default(theirs, row["eds"])
+            documented_ours = resolve_default(ours, row["motwin"])
+            documented_theirs = resolve_default(theirs, row["eds"])
         else:
             documented_ours, documented_theirs = doc_value(field, row["motwin"]), doc_value(field, row["eds"])
         actual_ours, actual_theirs = field_value(ours, field), field_value(theirs, field)
@@ -258,7 +259,8 @@ NAMED_SUB_INDICES = {("ADC Configuration", "ADC_I0_Raw"): 1, ("ADC Configuration
 def resolve(eds_entries, name, sub_name=None):
     """python-canopen's od[name] / od[name][sub_name]: the index (and sub-index) whose
     ParameterName is exactly the name; KeyError (here a failure) when none is."""
-    objects = [index for (index, sub), section in eds_entries.items() if sub is None and section["ParameterName"] == name]
+    objects = [index for (index, sub), section in eds_entries.items()
+               if sub is None and section["ParameterName"] == name]
     check(len(objects) == 1, f"{name!r} names {len(objects)} objects")
     if sub_name is None:
         return objects[0]
@@ -278,8 +280,8 @@ def test_names_the_examples_look_up_resolve(motwin):
                 check_equal(resolve(eds, name), NAMED_INDICES[name], f"{name!r}")
             for name, sub_names in NAMED_SUBS.items():
                 for sub_name in sub_names:
-                    check_equal(resolve(eds, name, sub_name), (NAMED_INDICES[name], NAMED_SUB_INDICES[(name, sub_name)]),
-                                f"{name!r}[{sub_name!r}]")
+                    check_equal(resolve(eds, name, sub_name),
+                                (NAMED_INDICES[name], NAMED_SUB_INDICES[(name, sub_name)]), f"{name!r}[{sub_name!r}]")
         except TestFailure as failure:
             raise TestFailure(f"{who}: {failure}") from None
     # The numbers the legacy scripts bind (module.sdo[0x2702] and so on) exist too; the
