@@ -250,9 +250,10 @@ constexpr void add_emergency_rows(Table& t, const CommunicationNames& n, Access 
   cob_id.check = [](Owner& d, uint8_t, int64_t v) {
     return check_emcy_cob_id(d.node().communication().emcy_cob_id, v, d.node().node_id());
   };
-  // A read-only 1014 is not stored: it is always 80h + the node ID.
+  // A read-only 1014 is always 80h + the node ID: its default, which reset communication loads
+  // (and a save skips, as every "$NODEID+" object at its default).
   t.add(plus_node_id(var<Owner>(0x1014, n.emcy_cob_id, DataType::kUnsigned32, cob_id_access, 0, kU32Max, 0x80, cob_id,
-                                cob_id_access == Access::kRw ? kComm : StorageGroup::kNone)));
+                                kComm)));
   t.add(var<Owner>(0x1015, n.emcy_inhibit, DataType::kUnsigned16, Access::kRw, 0, kU16Max, 0,
                    applied_binding<Owner, &CommunicationConfig::emcy_inhibit_100us,
                                    [](Node& node, uint16_t v) { node.emergency().set_inhibit_time_100us(v); }>(),

@@ -195,6 +195,8 @@ class AxisDrive {
  private:
   PdsOptions options() const;
   void emergency(DriveEvent event);
+  // A new 6060 takes effect: at the next step, or at once where a set-point or SYNC must see it.
+  void take_mode_change();
   void on_mode_change(int8_t from, int8_t to);
   void accept_set_point(uint16_t controlword);
   // 607A + the set-point's base, clamped to the software limits.

@@ -185,6 +185,9 @@ void AxisDrive<Manufacturer>::stop_ramp(double deceleration_pps2) {
 
 template <class Manufacturer>
 void AxisDrive<Manufacturer>::write_controlword(uint16_t controlword) {
+  // A mode written just before (an RPDO 2 of 6040 + 6060, or SDO writes with no tick between)
+  // applies before the controlword acts in it, as it would have a tick later.
+  take_mode_change();
   const uint16_t previous = controlword_;
   controlword_ = controlword;
   const PdsState before = pds_.state();
@@ -316,6 +319,7 @@ void AxisDrive<Manufacturer>::target_position_written() {
     }
   }
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncPosition) && us_since_sync_ >= kSyncAbsentUs) {
+    take_mode_change();  // a mode written in the same instant applies first (it would clear the latch)
     latch_cyclic_set_point();
   }
 }
@@ -328,6 +332,7 @@ void AxisDrive<Manufacturer>::target_velocity_written() {
     if (units().velocity_pps(objects.target_velocity) != ramp_.velocity()) target_reached_ = false;
   }
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncVelocity) && us_since_sync_ >= kSyncAbsentUs) {
+    take_mode_change();
     latch_cyclic_set_point();
   }
 }
@@ -335,6 +340,7 @@ void AxisDrive<Manufacturer>::target_velocity_written() {
 template <class Manufacturer>
 void AxisDrive<Manufacturer>::target_torque_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncTorque) && us_since_sync_ >= kSyncAbsentUs) {
+    take_mode_change();
     latch_cyclic_set_point();
   }
 }
@@ -342,6 +348,7 @@ void AxisDrive<Manufacturer>::target_torque_written() {
 template <class Manufacturer>
 void AxisDrive<Manufacturer>::on_sync() {
   us_since_sync_ = 0;
+  take_mode_change();
   latch_cyclic_set_point();
 }
 
@@ -385,6 +392,14 @@ int32_t AxisDrive<Manufacturer>::limited_torque(int32_t torque) const {
 }
 
 template <class Manufacturer>
+void AxisDrive<Manufacturer>::take_mode_change() {
+  if (objects.mode == active_mode_) return;
+  const int8_t from = active_mode_;
+  active_mode_ = objects.mode;
+  on_mode_change(from, active_mode_);
+}
+
+template <class Manufacturer>
 void AxisDrive<Manufacturer>::on_mode_change(int8_t from, int8_t to) {
   if (from == static_cast<int8_t>(Mode::kHoming) && homing_.active()) homing_.stop();
   // A servo's new mode starts from where the motor is and how fast it turns (bumpless).
@@ -419,11 +434,7 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   if (clear_stall_request_) in.stall = false;
   clear_stall_request_ = false;
   if (us_since_sync_ < kSyncAbsentUs) us_since_sync_ += dt_us;
-  if (objects.mode != active_mode_) {
-    const int8_t from = active_mode_;
-    active_mode_ = objects.mode;
-    on_mode_change(from, active_mode_);
-  }
+  take_mode_change();
   actual_velocity_pps_ = inputs.actual_velocity_pps;
   last_encoder_usteps_ = inputs.encoder_position_usteps;
   in.encoder_position_usteps = drive_detail::wrap(static_cast<int64_t>(inputs.encoder_position_usteps) + encoder_offset_);

@@ -35,40 +35,18 @@ struct SdoResult {
   std::string bytes;          // segmented upload
 };
 
-struct Tmcm3216Rig {
-  std::unique_ptr<Tmcm3216Nvm> nvm = std::make_unique<Tmcm3216Nvm>();
-  RecordingCanController can;
-  std::unique_ptr<Tmcm3216> device;
-  // Frames other than SDO responses that went out during sdo() calls (heartbeats).
+// A small SDO and NMT client in raw CiA-301 frames over a rig's send(frame) (which delivers one
+// frame and returns what the device transmitted) and node(); `other` collects what was not the
+// SDO response (heartbeats, EMCYs, PDOs).
+template <class Rig>
+struct CanopenClient {
   std::vector<can::CanFrame> other;
-
-  explicit Tmcm3216Rig(modules::tmcm3216::Tmcm3216Config config = {}, bool format = true) {
-    if (format) Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
-    device = std::make_unique<Tmcm3216>(*nvm, can, config);
-    device->power_up();
-  }
-
-  // Power cycle with the same NVM.
-  void power_cycle(modules::tmcm3216::Tmcm3216Config config = {}) {
-    device = std::make_unique<Tmcm3216>(*nvm, can, config);
-    device->power_up();
-  }
-
-  uint8_t node() const { return device->node_id(); }
-
-  // Delivers a frame and runs one process call (no time passes).
-  std::vector<can::CanFrame> send(const can::CanFrame& frame) {
-    can.take();
-    EXPECT_TRUE(device->receive(frame));
-    device->process(0);
-    return can.take();
-  }
 
   // One SDO request; expects exactly one response on 0x580 + node (other frames go to `other`).
   can::CanFrame sdo(std::initializer_list<uint8_t> bytes) {
     std::vector<can::CanFrame> responses;
-    for (const can::CanFrame& f : send(frame_of(0x600u + node(), bytes))) {
-      if (f.id == 0x580u + node()) {
+    for (const can::CanFrame& f : self().send(frame_of(0x600u + self().node(), bytes))) {
+      if (f.id == 0x580u + self().node()) {
         responses.push_back(f);
       } else {
         other.push_back(f);
@@ -133,7 +111,38 @@ struct Tmcm3216Rig {
     return r.value;
   }
 
-  void nmt(uint8_t command, uint8_t target) { send(frame_of(0x000, {command, target})); }
+  void nmt(uint8_t command, uint8_t target) { self().send(frame_of(0x000, {command, target})); }
+
+ private:
+  Rig& self() { return static_cast<Rig&>(*this); }
+};
+
+struct Tmcm3216Rig : CanopenClient<Tmcm3216Rig> {
+  std::unique_ptr<Tmcm3216Nvm> nvm = std::make_unique<Tmcm3216Nvm>();
+  RecordingCanController can;
+  std::unique_ptr<Tmcm3216> device;
+
+  explicit Tmcm3216Rig(modules::tmcm3216::Tmcm3216Config config = {}, bool format = true) {
+    if (format) Tmcm3216::format_factory_image(nvm->mutable_data(), nvm->size());
+    device = std::make_unique<Tmcm3216>(*nvm, can, config);
+    device->power_up();
+  }
+
+  // Power cycle with the same NVM.
+  void power_cycle(modules::tmcm3216::Tmcm3216Config config = {}) {
+    device = std::make_unique<Tmcm3216>(*nvm, can, config);
+    device->power_up();
+  }
+
+  uint8_t node() const { return device->node_id(); }
+
+  // Delivers a frame and runs one process call (no time passes).
+  std::vector<can::CanFrame> send(const can::CanFrame& frame) {
+    can.take();
+    EXPECT_TRUE(device->receive(frame));
+    device->process(0);
+    return can.take();
+  }
 };
 
 }  // namespace motwin::testing
