@@ -423,7 +423,7 @@ def test_encoder_pp_mode(motwin):
             try:
                 master.wait_until(f"|607A - 6064| < 100 moving to {target}",
                                   lambda: (master.read(0x607A), master.read(0x6064)),
-                                  lambda v: abs(v[0] - v[1]) < 100, 30.0)
+                                  lambda v: abs(v[0] - v[1]) < 100, 15.0)
             except TestFailure as failure:
                 # What a refused set-point looks like (bit 7 warning, bit 12 never set).
                 raise TestFailure(f"{failure}; 6081 = {master.read(0x6081)}, 6083 = {master.read(0x6083)}, "
