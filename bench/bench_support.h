@@ -67,6 +67,15 @@ struct RealTimeFactorSummary {
   const char* baseline_label;  // "the ideal motor": printed as "(2.0x slower than <label>)"
   double goal;                 // least acceptable real-time factor
   int name_width;              // of the case name column
+  // Cases held to another case of the same run: `name` runs at least `least_ratio` of `reference`'s
+  // real-time factor (the TMCM-1636's CANopen firmware against its TMCL firmware on one motion).
+  struct Comparison {
+    const char* name;
+    const char* reference;
+    const char* label;  // "canopen/tmcl"
+    double least_ratio;
+  };
+  std::vector<Comparison> comparisons = {};
 };
 
 class RealTimeFactorReporter final : public SummaryReporter {
@@ -82,6 +91,12 @@ class RealTimeFactorReporter final : public SummaryReporter {
       if (baseline != factor_.end() && name != summary_.baseline_name && factor > 0.0) {
         std::printf("  (%5.1fx slower than %s)  goal >= %.0fx: %s", baseline->second / factor, summary_.baseline_label,
                     summary_.goal, factor >= summary_.goal ? "met" : "NOT met");
+      }
+      for (const RealTimeFactorSummary::Comparison& c : summary_.comparisons) {
+        const auto reference = factor_.find(c.reference);
+        if (name != c.name || reference == factor_.end() || reference->second <= 0.0) continue;
+        const double ratio = factor / reference->second;
+        std::printf("; %s %.3f, goal >= %.2f: %s", c.label, ratio, c.least_ratio, ratio >= c.least_ratio ? "met" : "NOT met");
       }
       std::printf("\n");
     }

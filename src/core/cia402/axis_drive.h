@@ -115,8 +115,8 @@ enum class DriveControl : uint8_t { kPosition, kVelocity, kTorque };
 struct AxisDemand {
   DriveControl control = DriveControl::kPosition;
   int32_t position_usteps = 0;
-  int32_t velocity_pps = 0;
-  double velocity_exact_pps = 0.0;  // velocity_pps unrounded (a servo's feed-forward)
+  int32_t velocity_pps = 0;         // rounded (a stepper's; 0 for a servo)
+  double velocity_exact_pps = 0.0;  // unrounded (a servo's feed-forward)
   int32_t torque = 0;               // 6074, in the module's torque unit (control kTorque)
   bool power_enabled = false;
   bool brake_released_request = false;

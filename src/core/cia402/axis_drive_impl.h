@@ -449,7 +449,8 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   demand_.torque = control_ == DriveControl::kTorque ? cyclic_torque_ : 0;
   demand_.position_usteps = ramp_.position();
   demand_.velocity_exact_pps = ramp_.velocity();
-  demand_.velocity_pps = static_cast<int32_t>(std::lround(ramp_.velocity()));
+  // A stepper takes whole steps per second; a servo the exact value.
+  if constexpr (!Manufacturer::kServo) demand_.velocity_pps = static_cast<int32_t>(std::lround(ramp_.velocity()));
   demand_.power_enabled = pds_.power_enabled();
   const PdsState state = pds_.state();
   demand_.brake_released_request = pds_.power_enabled() &&

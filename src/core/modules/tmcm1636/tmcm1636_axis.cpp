@@ -49,15 +49,23 @@ void Tmcm1636Axis::seed_ramp() { ramp_.set_state(state.actual_position, servo_.v
 void Tmcm1636Axis::follow_position(int32_t position, double velocity_counts_per_s) {
   state.mode = MotionMode::kPosition;
   external_reference_ = true;
+  ramp_.set_position_target(position);  // kept as the target (AP 55's window)
+  ramp_.set_velocity_target(velocity_counts_per_s);
   ramp_.set_state(position, velocity_counts_per_s);
-  ramp_.set_position_target(position);
 }
 
 void Tmcm1636Axis::follow_velocity(double velocity_counts_per_s) {
+  // AP 40 (target velocity) is not kept: no host of this reference reads it, and the division
+  // would cost every tick.
   state.mode = MotionMode::kVelocity;
   external_reference_ = true;
-  state.target_velocity_rpm = round_to_int32(rpm(velocity_counts_per_s));
   ramp_.set_velocity_target(velocity_counts_per_s);
+}
+
+void Tmcm1636Axis::advance_reference(double dt_s) {
+  // Unbounded and without a ramp: the reference's velocity as it was given.
+  static constexpr motion::TrapezoidRampConfig kAsGiven{1e12, 0.0, false};
+  ramp_.step(kAsGiven, dt_s);
 }
 
 void Tmcm1636Axis::set_target_velocity(int32_t velocity_rpm) {
@@ -175,12 +183,7 @@ void Tmcm1636Axis::ideal_tick(const board::Tmcm1636Io& io, double dt_s) {
   if (io.reference_switch_level(board::ReferenceSwitch::kHome)) levels |= 4;
   update_switches(levels);
   if (state.driver_enabled != 0 && external_reference_) {
-    // The reference is the motion: a position is where the ramp was set, a velocity moves it.
-    if (state.mode == MotionMode::kVelocity) {
-      motion::TrapezoidRampConfig follow = ideal_ramp_config();
-      follow.ramp_enabled = false;
-      ramp_.step(follow, dt_s);
-    }
+    advance_reference(dt_s);  // the reference is the motion
   } else if (state.driver_enabled != 0 && state.mode != MotionMode::kTorque) {
     // Re-derived every tick: AP 100 (counts per revolution) may have changed.
     if (state.mode == MotionMode::kVelocity) ramp_.set_velocity_target(counts_per_second(state.target_velocity_rpm));

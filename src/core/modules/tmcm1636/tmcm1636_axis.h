@@ -206,10 +206,11 @@ class Tmcm1636Axis {
   void set_clear_on_null(int32_t clear);
 
   // A reference generated outside the axis: the CANopen firmware's CiA-402 drive profiles the
-  // motion (docs/tmcm-1636-canopen.md) and hands the axis, every tick before tick(), a position
-  // (axis counts) with its velocity as the feed-forward of the position regulator, or a velocity
-  // for the velocity regulator. The axis' own ramp (AP 43..45) is then not used; AP 43 still
-  // bounds the velocity reference. Any other command (set_target_*) ends it.
+  // motion (docs/tmcm-1636-canopen.md) and hands the axis a position (axis counts) with its
+  // velocity as the feed-forward of the position regulator, or a velocity for the velocity
+  // regulator. Between two the reference moves on with the velocity given. The axis' own ramp
+  // (AP 43..45) is then not used; AP 43 still bounds the velocity reference. Any other command
+  // (set_target_*) ends it.
   void follow_position(int32_t position, double velocity_counts_per_s);
   void follow_velocity(double velocity_counts_per_s);
   bool following_reference() const { return external_reference_; }
@@ -323,6 +324,8 @@ class Tmcm1636Axis {
   };
 
   void ideal_tick(const board::Tmcm1636Io& io, double dt_s);
+  // follow_position / follow_velocity's reference one tick on, at its velocity.
+  void advance_reference(double dt_s);
   // The steps of servo_tick() and read_sensors(), in their order. Declared inline: each is
   // defined and called only in tmcm1636_axis_servo.cpp, once per tick, and inline lets the
   // compiler fold them back into the tick (out of line, bench_tmcm1636_servo ran 4-7 % slower).

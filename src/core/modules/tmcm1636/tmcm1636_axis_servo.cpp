@@ -364,9 +364,10 @@ float Tmcm1636Axis::velocity_reference_rpm(double dt_s) {
   const bool open_loop = config.motor_type == MotorType::kBldc && config.commutation_mode == CommutationMode::kOpenLoop;
   double velocity_rpm = 0.0;
   if (external_reference_) {
-    // follow_position / follow_velocity set the reference of this tick.
-    velocity_rpm = to_rpm(ramp_.mode() == motion::TrapezoidRamp::Mode::kVelocity ? ramp_.target_velocity()
-                                                                                 : ramp_.velocity());
+    // follow_position / follow_velocity set the reference; it moves on with its velocity until the
+    // next one (the drive gives one a millisecond).
+    advance_reference(dt_s);
+    velocity_rpm = to_rpm(ramp_.velocity());
   } else if (state.mode == MotionMode::kVelocity) {
     ramp_.set_velocity_target(to_counts_per_s(state.target_velocity_rpm));
     ramp_.step(ramp_config, dt_s);

@@ -24,17 +24,23 @@ int32_t Tmcm1636Canopen::drive_position(int32_t axis_counts) const { return dire
 int32_t Tmcm1636Canopen::axis_position(int32_t drive_units) const { return axis_.axis_position(directed(drive_units)); }
 
 double Tmcm1636Canopen::drive_velocity(double axis_counts_per_s) const {
-  const double steps = axis_.config.encoder_steps;
-  if (steps <= 0.0) return 0.0;
-  const double v = axis_counts_per_s * static_cast<double>(axis_.config.position_scaler) / steps;
+  const double v = axis_counts_per_s * frames_.drive_units_per_count;
   return axis_.config.motor_direction != 0 ? -v : v;
 }
 
 double Tmcm1636Canopen::axis_velocity(double drive_units_per_s) const {
-  const double scaler = axis_.config.position_scaler;
-  if (scaler <= 0.0) return 0.0;
-  const double v = drive_units_per_s * static_cast<double>(axis_.config.encoder_steps) / scaler;
+  const double v = drive_units_per_s * frames_.counts_per_drive_unit;
   return axis_.config.motor_direction != 0 ? -v : v;
+}
+
+void Tmcm1636Canopen::refresh_frames() {
+  const int32_t scaler = axis_.config.position_scaler;
+  const int32_t steps = axis_.config.encoder_steps;
+  if (scaler == frames_.position_scaler && steps == frames_.encoder_steps) return;
+  frames_.position_scaler = scaler;
+  frames_.encoder_steps = steps;
+  frames_.drive_units_per_count = steps > 0 ? static_cast<double>(scaler) / steps : 0.0;
+  frames_.counts_per_drive_unit = scaler > 0 ? static_cast<double>(steps) / scaler : 0.0;
 }
 
 // --- The application -----------------------------------------------------------------------------
@@ -55,11 +61,13 @@ void Tmcm1636Canopen::reset_application() {
   application.node_settings = true;
   node_.load_stored(application);
   axis_.finish_restore();
-  drive_.manufacturer.position_scaler = axis_.config.position_scaler;
+  drive_.manufacturer.set_position_scaler(axis_.config.position_scaler);
+  refresh_frames();
   // The power stage is off until the drive is switched on.
   axis_.set_driver_enabled(false);
   driver_enabled_ = false;
   drive_.reset(0);
+  drive_ticks_ = 0;
   axis_.set_actual_position(0);
   apply_outputs();
 }
@@ -141,14 +149,17 @@ void Tmcm1636Canopen::apply_outputs() {
 
 void Tmcm1636Canopen::tick() {
   node_.tick(kControlTickUs);
-  run_axis(kControlTickUs);
+  if (++drive_ticks_ == kDriveTicks) {
+    drive_ticks_ = 0;
+    run_drive(kDrivePeriodUs);
+  }
+  axis_.tick(io_, static_cast<double>(kControlTickUs) * 1e-6);
 }
 
 cia402::AxisInputs Tmcm1636Canopen::axis_inputs() const {
   cia402::AxisInputs inputs;
   inputs.encoder_position_usteps = drive_position(axis_.actual_position());
-  inputs.actual_velocity_pps =
-      static_cast<double>(directed(axis_.state.actual_velocity_rpm)) * axis_.config.position_scaler / 60.0;
+  inputs.actual_velocity_pps = drive_.units().velocity_pps(directed(axis_.state.actual_velocity_rpm));
   // The switches' levels as the axis reads them (AP 210 polarity 0: high active), then 2005, in the
   // host's direction: with 2057 set the motor's right switch is the host's negative limit.
   const bool inverted = axis_.config.motor_direction != 0;
@@ -169,7 +180,8 @@ cia402::AxisInputs Tmcm1636Canopen::axis_inputs() const {
   return inputs;
 }
 
-void Tmcm1636Canopen::run_axis(uint32_t dt_us) {
+void Tmcm1636Canopen::run_drive(uint32_t dt_us) {
+  refresh_frames();
   // NMT stopped takes the drive function away from a running axis: FAULT.
   if (configured() && nmt_state() == NmtState::kStopped && drive_.state() == cia402::PdsState::kOperationEnabled) {
     drive_.external_fault();
@@ -178,7 +190,6 @@ void Tmcm1636Canopen::run_axis(uint32_t dt_us) {
   int32_t position = 0;
   if (drive_.take_position_assignment(position)) axis_.set_actual_position(axis_position(position));
   carry_out(drive_.demand());
-  axis_.tick(io_, static_cast<double>(dt_us) * 1e-6);
   report_drive_emergencies();
 }
 

@@ -154,8 +154,13 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   bool receive(const can::CanFrame& frame) { return node_.receive(frame); }
   void process(uint32_t elapsed_us) { node_.process(elapsed_us); }
   // One 50 µs control tick: the node's services (once per millisecond, or at once for a frame),
-  // then the drive and the axis' regulators.
+  // the drive once per kDrivePeriodUs, the axis' regulators every tick.
   void tick();
+  // The CiA-402 drive (profile generator, PDS, monitoring) runs once a millisecond, as a servo
+  // drive's application loop does above its current loop; the axis moves its reference on with the
+  // demand's velocity in between (Tmcm1636Axis::follow_position). docs/tmcm-1636-canopen.md.
+  static constexpr uint32_t kDrivePeriodUs = 1000;
+  static constexpr uint32_t kDriveTicks = kDrivePeriodUs / kControlTickUs;
 
   canopen::Node& node() { return node_; }
   uint8_t node_id() const { return node_.node_id(); }
@@ -198,7 +203,10 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   void on_bus_off() override;
   uint8_t application_error_register() const override;
 
-  void run_axis(uint32_t dt_us);
+  void run_drive(uint32_t dt_us);
+  // The velocity factors between the drive's and the axis' frames, derived again when 2058 or
+  // 2080:2 changed (not a division per tick).
+  void refresh_frames();
   cia402::AxisInputs axis_inputs() const;
   void carry_out(const cia402::AxisDemand& demand);
   void report_drive_emergencies();
@@ -209,6 +217,13 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   Tmcm1636Drive drive_{};
   Tmcm1636CanopenObjects objects_{};
   bool driver_enabled_ = false;  // what the axis was last told (AP 255)
+  uint32_t drive_ticks_ = 0;     // control ticks since the drive ran
+  struct Frames {
+    int32_t position_scaler = 0;
+    int32_t encoder_steps = -1;  // never a setting: the first refresh derives the factors
+    double drive_units_per_count = 0.0;
+    double counts_per_drive_unit = 0.0;
+  } frames_;
 
   Dictionary dictionary_;
   std::array<uint8_t, kNvmSize> storage_scratch_{};

@@ -2,8 +2,8 @@
 // parameter, see "The module's part" in core/cia402/axis_drive.h): a servo (the regulators of
 // Tmcm1636Axis follow the demand, the measured motion is the actual one), velocities in rpm and
 // accelerations in rpm/s of the shaft, positions in 2058 units (position scaler: units per
-// revolution), the profile generator in its plain trapezoid form (6081, 6083, 6084: nothing
-// shapes it further), modes pp, pv, hm, csp, csv and cst, homing methods 17, 18, 19, 21 and 35
+// revolution), the profile generator in its plain trapezoid form (6081, 6083, 6084; 6084 = 0
+// brakes with 6083), modes pp, pv, hm, csp, csv and cst, homing methods 17, 18, 19, 21 and 35
 // (PyTrinamic's homing example lists them), statusword bits 14 and 15 and the EMCY codes of the
 // Trinamic servo firmware family (docs/tmcm-1636-canopen.md).
 #pragma once
@@ -26,15 +26,21 @@ inline constexpr uint16_t kCanopenSwMotorActivity = 1u << 14;  // the motor move
 inline constexpr uint16_t kCanopenSwDirection = 1u << 15;      // direction of the last motion: 1 = negative
 
 struct Tmcm1636DriveObjects {
-  // 2058, copied here by the module: the drive's velocities are in 2058 units per second.
-  int32_t position_scaler = 65536;
-
-  // 606C, 60FF, 6081, 6099 in rpm; 6083, 6084, 6085, 609A in rpm/s.
-  cia402::UnitScale units() const {
-    const double units_per_rpm = static_cast<double>(position_scaler) / 60.0;
-    return cia402::UnitScale{units_per_rpm, units_per_rpm};
+  // 2058 (the module sets it with the axis' setting): the drive's velocities are in 2058 units per
+  // second, so 606C, 60FF, 6081, 6099 are rpm and 6083, 6084, 6085, 609A rpm/s.
+  void set_position_scaler(int32_t units_per_revolution) {
+    const double units_per_rpm = static_cast<double>(units_per_revolution) / 60.0;
+    scale = cia402::UnitScale{units_per_rpm, units_per_rpm};
   }
-  void shape_profile(motion::EightPointConfig&, const cia402::UnitScale&) const {}
+  // Derived once per 2058 write, not per use: the drive asks for it several times a tick.
+  cia402::UnitScale scale{65536.0 / 60.0, 65536.0 / 60.0};
+
+  cia402::UnitScale units() const { return scale; }
+  // The profile objects' trapezoid as it is, but a 6084 of 0 (the EDS's default, which
+  // PyTrinamic's pp example leaves) brakes with 6083: the example's move ends on its target.
+  void shape_profile(motion::EightPointConfig& profile, const cia402::UnitScale&) const {
+    if (profile.dmax_pps2 == 0.0) profile.dmax_pps2 = profile.d1_pps2 = profile.d2_pps2 = profile.amax_pps2;
+  }
 
   static constexpr cia402::AxisEmergency emergency(cia402::DriveEvent event) {
     using cia402::DriveEvent;

@@ -265,7 +265,7 @@ constexpr void add_motor_rows(Table& t) {
     // The drive's velocity units follow it (rpm = 2058 units / 60 s).
     b.set = [](Module& m, uint8_t, int64_t v) {
       m.axis().config.position_scaler = static_cast<int32_t>(v);
-      m.drive().manufacturer.position_scaler = static_cast<int32_t>(v);
+      m.drive().manufacturer.set_position_scaler(static_cast<int32_t>(v));
       return SdoAbort::kNone;
     };
     return b;
