@@ -41,9 +41,9 @@ SPEED = "10"
 # the two requests is needed to miss it.
 HOMING_SPEED = "2"
 REFERENCE_MOTOR = ["--motor", "qbl4208-61-04-013"]
-# The bench of the TMCL replays (test_tmcm1636_examples.py): a right and a left switch three
-# revolutions either side of the start that pull their inputs low while the rotor is past them.
-SWITCHES = ["--set", "REF_AT_LEVEL=0", "--set", "REF_R_AT=3", "--set", "REF_L_AT=-3"]
+# A right and a left switch three revolutions either side of the start whose inputs are high while
+# the rotor is past them: active for 2005 = 0, the family's default polarity (docs/tmcm-1636-canopen.md).
+SWITCHES = ["--set", "REF_R_AT=3", "--set", "REF_L_AT=-3"]
 TRINAMIC_EDS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data",
                             "TMCM-1636-CANopen_Hw1.1_Fw1.12.eds")
 # BaseNode402's state-change step: a TPDO must report the new state within 0.4 s of the RPDO.

@@ -327,9 +327,7 @@ TEST(Tmcm1636Canopen, profile_position_on_the_reference_motor_reaches_the_target
 
 TEST(Tmcm1636Canopen, homing_on_the_negative_limit_switch_sets_home_there) {
   Tmcm1636CanopenRig rig(reference_motor());
-  rig.board->set_input("REF_AT_LEVEL", 0);  // the switches are closed (active) at their positions
-  rig.board->set_input("REF_L_AT", -0.5);   // half a revolution to the left
-  rig.board->set_input("REF_R_AT", 3.0);    // three to the right
+  rig.board->set_input("REF_L_AT", -0.5);  // a left switch half a revolution to the left (high past it)
   EXPECT_EQ(rig.download(0x2005, 0, 0), 0u);  // both limit switches used
   EXPECT_EQ(rig.download(0x6098, 0, 17, 1), 0u);
   EXPECT_EQ(rig.download(0x6098, 0, 1, 1), 0x0609'0030u);  // index methods are not this firmware's

@@ -61,6 +61,11 @@ void Tmcm1636Canopen::reset_application() {
   application.node_settings = true;
   node_.load_stored(application);
   axis_.finish_restore();
+  // The switches' electrical levels, high = active, as the family's 2005 reads them (it inverts
+  // them, bit 2/3/5); the TMCL firmware's AP 210 has no object here. And the axis stops for no
+  // switch itself (AP 209): the drive does, as 2005 says.
+  axis_.config.reference_switch_polarity = 7;
+  axis_.config.reference_switch_enable = 0;
   drive_.manufacturer.set_position_scaler(axis_.config.position_scaler);
   refresh_frames();
   // The power stage is off until the drive is switched on.
@@ -160,7 +165,7 @@ cia402::AxisInputs Tmcm1636Canopen::axis_inputs() const {
   cia402::AxisInputs inputs;
   inputs.encoder_position_usteps = drive_position(axis_.actual_position());
   inputs.actual_velocity_pps = drive_.units().velocity_pps(directed(axis_.state.actual_velocity_rpm));
-  // The switches' levels as the axis reads them (AP 210 polarity 0: high active), then 2005, in the
+  // The switches' levels (the axis reads them high-active: reset_application), then 2005, in the
   // host's direction: with 2057 set the motor's right switch is the host's negative limit.
   const bool inverted = axis_.config.motor_direction != 0;
   const bool motor_left = axis_.state.left_switch_active != 0;
