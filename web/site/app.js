@@ -867,7 +867,7 @@
     const read = (index, sub) => ask({ op: "sdo_read", module: module.module, index: index, sub: sub });
     let done = 0;
     for (const object of communication) {
-      const name = object.name.replace(/ communication parameter.*$/, "");
+      const name = pdoName(object.name);
       const tr = document.createElement("tr");
       tr.dataset.pdo = hex4(object.index + 0x200);
       tr.append(cell(name + " (" + hex4(object.index) + " / " + hex4(object.index + 0x200) + ")"), cell(object.axis),
@@ -896,6 +896,15 @@
       done++;
       $("canopen-pdo-note").textContent = done + " of " + communication.length + " read";
     }
+  }
+
+  // "TPDO 1" from the communication object's name: "TPDO 1 communication parameter: COB-ID used by
+  // TPDO" (the TMCM-3216) or, as Trinamic's EDS names them (the TMCM-1636), "Transmit PDO
+  // Communication Parameter 1: COB-ID".
+  function pdoName(name) {
+    const eds = /^(Receive|Transmit) PDO Communication Parameter (\d+)/i.exec(name);
+    if (eds) return (eds[1].toLowerCase() === "receive" ? "RPDO " : "TPDO ") + eds[2];
+    return name.replace(/ communication parameter.*$/, "");
   }
 
   // --- Bus monitor: the "frames" pushes of the `monitor` op, decoded by the predefined
