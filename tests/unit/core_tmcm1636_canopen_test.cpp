@@ -145,6 +145,31 @@ TEST(Tmcm1636Canopen, boot_mode_key_is_refused_and_other_values_change_nothing) 
   EXPECT_EQ(rig.read_u32(0x5FFF, 0), 0u);
 }
 
+// The family's 2703 (docs/canopen.md "2703 sub 1", as CiA-401's 6200h with its filter mask 6208h):
+// sub 1 reads back as written, the mask decides which outputs switch, bits that name no output
+// (the TMCM-1636 has GPO0 and GPO1) are refused. Found by the tmcm1636_canopen fuzz target: a write
+// without a mask was acknowledged and read 0.
+TEST(Tmcm1636Canopen, physical_outputs_read_back_as_written_and_the_mask_decides_what_switches) {
+  Tmcm1636CanopenRig rig;
+  EXPECT_EQ(rig.download(0x2703, 1, 0x3), 0u);  // no mask: nothing switches
+  EXPECT_EQ(rig.read_u32(0x2703, 1), 0x3u);
+  EXPECT_FALSE(rig.io.digital_output(0));
+  EXPECT_FALSE(rig.io.digital_output(1));
+  EXPECT_EQ(rig.download(0x2703, 2, 0x1), 0u);  // GPO0 only
+  EXPECT_EQ(rig.download(0x2703, 1, 0x3), 0u);
+  EXPECT_TRUE(rig.io.digital_output(0));
+  EXPECT_FALSE(rig.io.digital_output(1));
+  EXPECT_EQ(rig.download(0x2703, 2, 0x3), 0u);
+  EXPECT_EQ(rig.download(0x2703, 1, 0x2), 0u);
+  EXPECT_EQ(rig.read_u32(0x2703, 1), 0x2u);
+  EXPECT_FALSE(rig.io.digital_output(0));
+  EXPECT_TRUE(rig.io.digital_output(1));
+  EXPECT_EQ(rig.download(0x2703, 1, 0x6576'6173), 0x0609'0030u);  // "save": bits beyond GPO1
+  EXPECT_EQ(rig.download(0x2703, 1, 0x4), 0x0609'0030u);
+  EXPECT_EQ(rig.read_u32(0x2703, 1), 0x2u);
+  EXPECT_TRUE(rig.io.digital_output(1));
+}
+
 TEST(Tmcm1636Canopen, switch_parameters_are_written_in_switch_on_disabled_only) {
   Tmcm1636CanopenRig rig;
   EXPECT_EQ(rig.download(0x2005, 0, 0), 0u);
@@ -342,6 +367,32 @@ TEST(Tmcm1636Canopen, homing_on_the_negative_limit_switch_sets_home_there) {
   EXPECT_NE(rig.statusword() & (1u << 10), 0u);
   EXPECT_NEAR(rig.read_i32(0x6064), 0, 700);  // home: where the switch is left, 607C = 0
   EXPECT_NEAR(rig.board->plant()->mechanical_angle_rad() / (2 * M_PI), -0.5, 0.05);
+}
+
+TEST(Tmcm1636Canopen, an_undervoltage_faults_the_drive_with_its_emergency_and_0000_when_it_is_gone) {
+  Tmcm1636CanopenRig rig(reference_motor());
+  rig.enable(3);
+  rig.sent.clear();
+  rig.board->set_input("VSUPPLY", 7.0);
+  // The bus capacitance discharges into the board (the TMCL servo test's 1 s).
+  rig.run_until([&] { return (rig.device->status_flags() & modules::tmcm1636::kFlagUndervoltage) != 0; }, 3000);
+  rig.run_ms(2);
+  std::vector<can::CanFrame> emcy = frames_with_id(rig.sent, 0x81);
+  ASSERT_FALSE(emcy.empty());
+  EXPECT_EQ(emcy[0].data[0] | emcy[0].data[1] << 8, 0xFF00);
+  EXPECT_NE(emcy[0].data[2] & 0x04, 0);  // 1001: voltage
+  EXPECT_EQ(rig.statusword() & 0x4F, 0x08);  // FAULT
+  EXPECT_NE(rig.read_u32(0x2101, 0) & modules::tmcm1636::kFlagUndervoltage, 0u);
+  rig.sent.clear();
+  rig.board->set_input("VSUPPLY", 24.0);
+  rig.run_ms(300);
+  emcy = frames_with_id(rig.sent, 0x81);
+  ASSERT_EQ(emcy.size(), 1u);
+  EXPECT_EQ(emcy[0].data[0] | emcy[0].data[1] << 8, 0x0000);
+  EXPECT_EQ(rig.statusword() & 0x4F, 0x08);  // still FAULT until a fault reset
+  EXPECT_EQ(rig.download(0x6040, 0, 0x80, 2), 0u);
+  rig.run_ms(2);
+  EXPECT_EQ(rig.statusword() & 0x4F, 0x40);  // SWITCH ON DISABLED
 }
 
 TEST(Tmcm1636Canopen, a_value_out_of_range_is_refused_and_changes_nothing) {

@@ -73,6 +73,7 @@ void Tmcm1636Canopen::reset_application() {
   driver_enabled_ = false;
   drive_.reset(0);
   drive_ticks_ = 0;
+  reported_protections_ = 0;
   axis_.set_actual_position(0);
   apply_outputs();
 }
@@ -140,13 +141,15 @@ uint32_t Tmcm1636Canopen::digital_inputs() const {
 }
 
 void Tmcm1636Canopen::write_outputs(uint32_t value) {
-  objects_.outputs = (objects_.outputs & ~objects_.output_mask) | (value & objects_.output_mask);
+  objects_.outputs = value;
+  objects_.output_levels =
+      (objects_.output_levels & ~objects_.output_mask) | (value & objects_.output_mask & kCanopenOutputBits);
   apply_outputs();
 }
 
 void Tmcm1636Canopen::apply_outputs() {
   for (uint8_t port = 0; port < board::Tmcm1636Io::kDigitalOutputCount; ++port) {
-    io_.set_digital_output(port, ((objects_.outputs >> port) & 1u) != 0);
+    io_.set_digital_output(port, ((objects_.output_levels >> port) & 1u) != 0);
   }
 }
 
@@ -225,6 +228,28 @@ void Tmcm1636Canopen::report_drive_emergencies() {
     const uint8_t data[5] = {emcy.sub, 0, 0, 0, 0};
     node_.emergency().report(emcy.code, error_register(), data);
   }
+  // A protection that trips: its EMCY once (the drive goes to FAULT, power_stage_fault); all gone:
+  // 0000.
+  struct Protection {
+    uint32_t flag;
+    uint16_t code;
+    uint8_t byte3;
+  };
+  static constexpr Protection kProtections[] = {{status_flag::kUndervoltage, kCanopenEmcyUndervoltage, 0},
+                                                {status_flag::kOvervoltage, kCanopenEmcyOvervoltage, 0},
+                                                {status_flag::kOvertemperature, kCanopenEmcyOvertemperature, 2}};
+  uint32_t active = 0;
+  for (const Protection& p : kProtections) active |= axis_.state.status_flags & p.flag;
+  for (const Protection& p : kProtections) {
+    if ((active & p.flag) == 0 || (reported_protections_ & p.flag) != 0) continue;
+    const uint8_t data[5] = {p.byte3, 0, 0, 0, 0};
+    node_.emergency().report(p.code, error_register(), data);
+  }
+  if (active == 0 && reported_protections_ != 0) {
+    const uint8_t data[5] = {};
+    node_.emergency().report(canopen::kEmcyErrorReset, error_register(), data);
+  }
+  reported_protections_ = active;
 }
 
 }  // namespace motwin::modules::tmcm1636

@@ -102,9 +102,13 @@ inline constexpr AxisParameterObject kAxisParameterObjects[] = {
 struct Tmcm1636CanopenObjects {
   // 2005 (cia402/switch_parameters.h; the EDS's default 3: neither limit switch used).
   uint32_t switch_parameters = cia402::switch_parameter::kLeftDisabled | cia402::switch_parameter::kRightDisabled;
-  uint32_t outputs = 0;      // 2703 sub 1: bit n drives GPO n
-  uint32_t output_mask = 0;  // 2703 sub 2: which bits a write of sub 1 changes
+  uint32_t outputs = 0;        // 2703 sub 1 as written: bit n for GPO n
+  uint32_t output_mask = 0;    // 2703 sub 2: which outputs a write of sub 1 switches
+  uint32_t output_levels = 0;  // the levels GPO n is switched to (bit n)
 };
+
+// 2703 sub 1's bits: GPO0 and GPO1; others name no output and are refused.
+inline constexpr uint32_t kCanopenOutputBits = (1u << board::Tmcm1636Io::kDigitalOutputCount) - 1;
 
 class Tmcm1636Canopen final : private canopen::NodeApplication {
  public:
@@ -193,7 +197,9 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   uint32_t digital_inputs() const;
   // 2702: the general-purpose inputs' levels, bit n = GPI n.
   uint32_t device_digital_inputs() const;
-  // 2703 sub 1 written: the bits the mask (sub 2) allows change, the outputs follow.
+  // 2703 sub 1 written (bits of kCanopenOutputBits only, the dictionary refuses others): it reads
+  // back as written, and the outputs whose bit the mask (sub 2) sets switch to its bits, the
+  // others keep their level (docs/canopen.md "2703 sub 1", the family's rule).
   void write_outputs(uint32_t value);
 
  private:
@@ -218,6 +224,7 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   Tmcm1636CanopenObjects objects_{};
   bool driver_enabled_ = false;  // what the axis was last told (AP 255)
   uint32_t drive_ticks_ = 0;     // control ticks since the drive ran
+  uint32_t reported_protections_ = 0;  // status_flag bits of the protections whose EMCY went out
   struct Frames {
     int32_t position_scaler = 0;
     int32_t encoder_steps = -1;  // never a setting: the first refresh derives the factors

@@ -20,6 +20,11 @@ inline constexpr uint16_t kCanopenEmcyFaultReset = 0x0000;
 inline constexpr uint16_t kCanopenEmcyFollowingError = 0x8611;
 inline constexpr uint16_t kCanopenEmcyLimit = 0xFF01;  // additional byte 1: 1/2 software limit, 3/4 switch
 inline constexpr uint16_t kCanopenEmcyGeneric = 0x1000;
+// The power stage's protections (the axis' status flags): the family's undervoltage and
+// overtemperature codes, CiA-402's DC link overvoltage (docs/tmcm-1636-canopen.md "Emergencies").
+inline constexpr uint16_t kCanopenEmcyUndervoltage = 0xFF00;
+inline constexpr uint16_t kCanopenEmcyOvervoltage = 0x3210;
+inline constexpr uint16_t kCanopenEmcyOvertemperature = 0x4310;
 
 // Statusword bits 14 and 15, manufacturer-specific in CiA-402.
 inline constexpr uint16_t kCanopenSwMotorActivity = 1u << 14;  // the motor moves

@@ -338,6 +338,10 @@ constexpr void add_device_rows(Table& t) {
       m.write_outputs(static_cast<uint32_t>(v));
       return SdoAbort::kNone;
     };
+    // GPO0 and GPO1 only: other bits name no output (the family's 2703, docs/canopen.md).
+    b.check = [](Module&, uint8_t, int64_t v) {
+      return (static_cast<uint32_t>(v) & ~kCanopenOutputBits) == 0 ? SdoAbort::kNone : SdoAbort::kInvalidValue;
+    };
     t.add(r::row<Module>(0x2703, 1, ObjectCode::kArray, "Device Digital Outputs", "Pysical Outputs", kUnsigned32,
                          Access::kRw, 0, r::kU32Max, 0, b));
   }
