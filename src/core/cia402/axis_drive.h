@@ -43,8 +43,8 @@
 //       the measured motion whenever the motion is handed over (a mode change, the power stage off,
 //       leaving cst); a position assignment (homing) is the module's to carry out on the axis'
 //       counter (take_position_assignment), the drive does not re-base the reading.
-// The member definitions are in axis_drive_impl.h, compiled once per module where the module
-// instantiates its drive (the TMCM-3216: src/core/modules/tmcm3216/tmcm3216_drive.{h,cpp}).
+// AxisDrive<Part> is a thin layer that hands the part's answers to AxisDriveCore, the drive itself,
+// compiled once in axis_drive.cpp for every module.
 #pragma once
 
 #include <array>
@@ -124,17 +124,16 @@ struct AxisDemand {
   bool clear_stall = false;  // the stall was handled: detect the next one
 };
 
-template <class Manufacturer>
-class AxisDrive {
-  static_assert(ManufacturerPart<Manufacturer>, "see \"The module's part\" above");
-
+// The drive without the module's part, compiled once (axis_drive.cpp) for every module: what the
+// part decides reaches it as data its AxisDrive<Part> hands in before each entry point (the unit
+// scale, the shaped profile, whether a servo follows the demand), and the events it reports are
+// given their EMCY codes there.
+class AxisDriveCore {
  public:
-  using Part = Manufacturer;
   // csp/csv/cst: a set-point written without a SYNC for this long is taken at once.
   static constexpr uint32_t kSyncAbsentUs = 100'000;
 
   ProfileObjects objects;
-  Manufacturer manufacturer{};
 
   // Power-up and NMT reset node: SWITCH ON DISABLED, standing at `position`, objects kept.
   void reset(int32_t position = 0);
@@ -169,14 +168,20 @@ class AxisDrive {
   const AxisDemand& demand() const { return demand_; }
   // A position assignment (homing) for the stepper since the last call.
   bool take_position_assignment(int32_t& position);
-  bool take_emergency(AxisEmergency& out);
+  // A drive event since the last call (AxisDrive gives it its EMCY code).
+  bool take_event(DriveEvent& out);
 
+  // 6041 without the module's bits (AxisDrive adds them).
   uint16_t statusword() const;
+  // Whether the motor moves, and the direction of its last motion (statusword bits 14/15 of the
+  // Trinamic drives).
+  bool motor_active() const { return !ramp_.standstill(); }
+  bool negative_direction() const { return negative_direction_; }
   int8_t mode_display() const { return objects.mode; }  // 6061 follows 6060 at once
   int32_t position_demand() const { return ramp_.position(); }  // 6062
   int32_t position_actual() const;                               // 6063 / 6064
-  int32_t velocity_actual_value() const;                         // 606C in object units
-  int32_t velocity_demand_value() const { return units().velocity_value(ramp_.velocity()); }  // 606B
+  // 606C in internal units: the measured velocity of a servo, the ramp's of a stepper.
+  double velocity_actual_pps() const { return servo_ ? actual_velocity_pps_ : ramp_.velocity(); }
   double velocity_pps() const { return ramp_.velocity(); }
   PdsState state() const { return pds_.state(); }
   const PowerDriveSystem& pds() const { return pds_; }
@@ -185,12 +190,19 @@ class AxisDrive {
   bool target_reached() const { return target_reached_; }
   bool following_error() const { return following_error_; }
   bool limit_active() const { return limit_active_; }
-  UnitScale units() const { return manufacturer.units(); }
-  // The profile of the present mode in internal units: 6081..6085, shaped by the module.
-  motion::EightPointConfig profile_config() const;
+  // The profile objects' trapezoid in internal units (6081..6085 and 607F, with `units`).
+  motion::EightPointConfig trapezoid_config(const UnitScale& units) const;
   // Software limits corrected by the home offset (607D, manual 6.1.11); false when unlimited.
   bool min_limit(int64_t& limit) const;
   bool max_limit(int64_t& limit) const;
+
+ protected:
+  // Out of line: the members' initial values are a good deal of code, written once for all parts.
+  explicit AxisDriveCore(bool servo);
+  // What the module's part says, as AxisDrive<Part>::prepare() hands it in.
+  bool servo_;
+  UnitScale units_{};
+  motion::EightPointConfig profile_{};  // the trapezoid shaped by the module
 
  private:
   PdsOptions options() const;
@@ -212,7 +224,7 @@ class AxisDrive {
   void run_cyclic_position(double dt_s);
   void run_cyclic_velocity(const AxisInputs& inputs, double dt_s);
   void run_cyclic_torque();
-  // A servo's profile generator takes the measured motion (Manufacturer::kServo).
+  // A servo's profile generator takes the measured motion (the part's kServo).
   void follow_actual_motion();
   int32_t limited_torque(int32_t torque) const;
   void latch_cyclic_set_point();
@@ -283,9 +295,80 @@ class AxisDrive {
   bool position_assigned_ = false;
   int32_t assigned_position_ = 0;
 
-  std::array<AxisEmergency, 8> emcy_{};
+  std::array<DriveEvent, 8> emcy_{};
   size_t emcy_head_ = 0;
   size_t emcy_count_ = 0;
+};
+
+// One CiA-402 axis of a module: the drive with the module's part (see "The module's part" above).
+// The part's calls inline here; the rest is AxisDriveCore's, compiled once.
+template <class Manufacturer>
+class AxisDrive : public AxisDriveCore {
+  static_assert(ManufacturerPart<Manufacturer>, "see \"The module's part\" above");
+
+ public:
+  using Part = Manufacturer;
+  Manufacturer manufacturer{};
+
+  AxisDrive() : AxisDriveCore(Manufacturer::kServo) {}
+
+  void reset(int32_t position = 0) {
+    prepare();
+    AxisDriveCore::reset(position);
+  }
+  void write_controlword(uint16_t controlword) {
+    prepare();
+    AxisDriveCore::write_controlword(controlword);
+  }
+  void target_position_written() {
+    prepare();
+    AxisDriveCore::target_position_written();
+  }
+  void target_velocity_written() {
+    prepare();
+    AxisDriveCore::target_velocity_written();
+  }
+  void target_torque_written() {
+    prepare();
+    AxisDriveCore::target_torque_written();
+  }
+  void on_sync() {
+    prepare();
+    AxisDriveCore::on_sync();
+  }
+  void step(const AxisInputs& inputs, uint32_t dt_us) {
+    prepare();
+    AxisDriveCore::step(inputs, dt_us);
+  }
+
+  bool take_emergency(AxisEmergency& out) {
+    DriveEvent event{};
+    if (!take_event(event)) return false;
+    out = Manufacturer::emergency(event);
+    return true;
+  }
+  uint16_t statusword() const {
+    return static_cast<uint16_t>(AxisDriveCore::statusword() |
+                                 Manufacturer::manufacturer_status_bits(motor_active(), negative_direction()));
+  }
+  int32_t velocity_actual_value() const { return units().velocity_value(velocity_actual_pps()); }  // 606C
+  int32_t velocity_demand_value() const { return units().velocity_value(ramp().velocity()); }       // 606B
+  UnitScale units() const { return manufacturer.units(); }
+  // The profile of the present mode in internal units: 6081..6085, shaped by the module.
+  motion::EightPointConfig profile_config() const {
+    const UnitScale u = units();
+    motion::EightPointConfig c = trapezoid_config(u);
+    manufacturer.shape_profile(c, u);
+    return c;
+  }
+
+ private:
+  // The part's view as it is now, for the core's entry point that follows (its objects may have
+  // changed by SDO since the last one).
+  void prepare() {
+    units_ = units();
+    profile_ = profile_config();
+  }
 };
 
 }  // namespace motwin::cia402

@@ -76,9 +76,8 @@ struct Tmcm1636DriveObjects {
   static constexpr bool kServo = true;
 };
 
-// The axis' drive (instantiated once, in tmcm1636_canopen_drive.cpp).
+// The axis' drive.
 using Tmcm1636Drive = cia402::AxisDrive<Tmcm1636DriveObjects>;
 
 }  // namespace motwin::modules::tmcm1636
 
-extern template class motwin::cia402::AxisDrive<motwin::modules::tmcm1636::Tmcm1636DriveObjects>;

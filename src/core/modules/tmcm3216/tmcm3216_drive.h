@@ -94,10 +94,8 @@ struct Tmcm3216DriveObjects {
   }
 };
 
-// One axis of the module: the generic drive with the module's part (instantiated once, in
-// tmcm3216_drive.cpp).
+// One axis of the module: the generic drive with the module's part.
 using Tmcm3216Drive = cia402::AxisDrive<Tmcm3216DriveObjects>;
 
 }  // namespace motwin::modules::tmcm3216
 
-extern template class motwin::cia402::AxisDrive<motwin::modules::tmcm3216::Tmcm3216DriveObjects>;

@@ -1,9 +1,4 @@
-// The member definitions of cia402::AxisDrive (axis_drive.h). A module includes this file once,
-// in the source file that instantiates its drive with its part
-// (`template class cia402::AxisDrive<Part>;`, e.g. src/core/modules/tmcm3216/tmcm3216_drive.cpp);
-// every other file includes only axis_drive.h.
-#pragma once
-
+// cia402::AxisDriveCore (axis_drive.h): the CiA-402 drive of every module, compiled once.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -23,8 +18,9 @@ inline int32_t difference(int32_t a, int32_t b) { return wrap(static_cast<int64_
 
 }  // namespace drive_detail
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::reset(int32_t position) {
+AxisDriveCore::AxisDriveCore(bool servo) : servo_(servo) {}
+
+void AxisDriveCore::reset(int32_t position) {
   pds_.reset();
   ramp_ = motion::EightPointRamp{};
   ramp_.set_position(position);
@@ -66,8 +62,7 @@ void AxisDrive<Manufacturer>::reset(int32_t position) {
   emcy_count_ = 0;
 }
 
-template <class Manufacturer>
-PdsOptions AxisDrive<Manufacturer>::options() const {
+PdsOptions AxisDriveCore::options() const {
   PdsOptions o;
   o.quick_stop = objects.quick_stop_option;
   o.shutdown = objects.shutdown_option;
@@ -77,15 +72,13 @@ PdsOptions AxisDrive<Manufacturer>::options() const {
   return o;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::emergency(DriveEvent event) {
+void AxisDriveCore::emergency(DriveEvent event) {
   if (emcy_count_ == emcy_.size()) return;  // the oldest are kept: they name the first cause
-  emcy_[(emcy_head_ + emcy_count_) % emcy_.size()] = Manufacturer::emergency(event);
+  emcy_[(emcy_head_ + emcy_count_) % emcy_.size()] = event;
   ++emcy_count_;
 }
 
-template <class Manufacturer>
-bool AxisDrive<Manufacturer>::take_emergency(AxisEmergency& out) {
+bool AxisDriveCore::take_event(DriveEvent& out) {
   if (emcy_count_ == 0) return false;
   out = emcy_[emcy_head_];
   emcy_head_ = (emcy_head_ + 1) % emcy_.size();
@@ -93,19 +86,17 @@ bool AxisDrive<Manufacturer>::take_emergency(AxisEmergency& out) {
   return true;
 }
 
-template <class Manufacturer>
-bool AxisDrive<Manufacturer>::take_position_assignment(int32_t& position) {
+bool AxisDriveCore::take_position_assignment(int32_t& position) {
   if (!position_assigned_) return false;
   position = assigned_position_;
   position_assigned_ = false;
   return true;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::assign_position(int32_t position) {
+void AxisDriveCore::assign_position(int32_t position) {
   // A stepper's encoder keeps its own count: it is re-based. A servo's module sets the axis'
   // counter itself (take_position_assignment), so the next reading is the new position.
-  if constexpr (!Manufacturer::kServo) encoder_offset_ = drive_detail::difference(position, last_encoder_usteps_);
+  if (!servo_) encoder_offset_ = drive_detail::difference(position, last_encoder_usteps_);
   ramp_.set_position(position);
   ramp_.halt();
   target_ = position;
@@ -117,9 +108,7 @@ void AxisDrive<Manufacturer>::assign_position(int32_t position) {
 
 // --- Units and profiles -----------------------------------------------------------------------
 
-template <class Manufacturer>
-motion::EightPointConfig AxisDrive<Manufacturer>::profile_config() const {
-  const UnitScale u = units();
+motion::EightPointConfig AxisDriveCore::trapezoid_config(const UnitScale& u) const {
   // The profile objects make a plain trapezoid: the segments below V1 and V2 brake with DMAX.
   motion::EightPointConfig c;
   c.vmax_pps = u.velocity_pps(objects.profile_velocity);
@@ -130,28 +119,24 @@ motion::EightPointConfig AxisDrive<Manufacturer>::profile_config() const {
   c.vstop_pps = u.velocity_pps(objects.end_velocity);
   // 607F bounds the profile velocity (0: no bound).
   if (objects.max_profile_velocity != 0) c.vmax_pps = std::min(c.vmax_pps, u.velocity_pps(objects.max_profile_velocity));
-  manufacturer.shape_profile(c, u);
   return c;
 }
 
-template <class Manufacturer>
-bool AxisDrive<Manufacturer>::min_limit(int64_t& limit) const {
+bool AxisDriveCore::min_limit(int64_t& limit) const {
   if (objects.software_limit_min == drive_detail::kMin32) return false;
   limit = static_cast<int64_t>(objects.software_limit_min) - objects.home_offset;
   return true;
 }
 
-template <class Manufacturer>
-bool AxisDrive<Manufacturer>::max_limit(int64_t& limit) const {
+bool AxisDriveCore::max_limit(int64_t& limit) const {
   if (objects.software_limit_max == drive_detail::kMax32) return false;
   limit = static_cast<int64_t>(objects.software_limit_max) - objects.home_offset;
   return true;
 }
 
-template <class Manufacturer>
-double AxisDrive<Manufacturer>::slow_down_pps2() const {
+double AxisDriveCore::slow_down_pps2() const {
   // "The slow down ramp is the deceleration value of the used mode of operation" (5.1.1).
-  const UnitScale u = units();
+  const UnitScale& u = units_;
   double value = 0;
   switch (static_cast<Mode>(active_mode_)) {
     case Mode::kProfileVelocity: value = objects.profile_acceleration; break;
@@ -163,8 +148,7 @@ double AxisDrive<Manufacturer>::slow_down_pps2() const {
   return u.acceleration_pps2(value);
 }
 
-template <class Manufacturer>
-double AxisDrive<Manufacturer>::interpolation_period_s() const {
+double AxisDriveCore::interpolation_period_s() const {
   double period = objects.interpolation_period;
   for (int i = 0; i < std::abs(objects.interpolation_index); ++i) {
     period = objects.interpolation_index < 0 ? period / 10.0 : period * 10.0;
@@ -172,8 +156,7 @@ double AxisDrive<Manufacturer>::interpolation_period_s() const {
   return period;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::stop_ramp(double deceleration_pps2) {
+void AxisDriveCore::stop_ramp(double deceleration_pps2) {
   if (deceleration_pps2 <= 0.0) {
     ramp_.halt();  // no ramp configured: stop at once
     return;
@@ -183,8 +166,7 @@ void AxisDrive<Manufacturer>::stop_ramp(double deceleration_pps2) {
 
 // --- Controlword and set-points --------------------------------------------------------------
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::write_controlword(uint16_t controlword) {
+void AxisDriveCore::write_controlword(uint16_t controlword) {
   // A mode written just before (an RPDO 2 of 6040 + 6060, or SDO writes with no tick between)
   // applies before the controlword acts in it, as it would have a tick later.
   take_mode_change();
@@ -228,10 +210,9 @@ void AxisDrive<Manufacturer>::write_controlword(uint16_t controlword) {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::accept_set_point(uint16_t controlword) {
+void AxisDriveCore::accept_set_point(uint16_t controlword) {
   if (pending_) return;  // the buffer is full: bit 12 stays set, the edge is not taken
-  const motion::EightPointConfig config = profile_config();
+  const motion::EightPointConfig config = profile_;
   if (motion::EightPointRamp::validate(config) != motion::EightPointConfigError::kNone || config.vmax_pps <= 0.0) {
     set_point_refused_ = true;  // statusword bit 7 (warning) until a set-point is accepted
     return;
@@ -267,8 +248,7 @@ void AxisDrive<Manufacturer>::accept_set_point(uint16_t controlword) {
   }
 }
 
-template <class Manufacturer>
-int32_t AxisDrive<Manufacturer>::set_point_target() {
+int32_t AxisDriveCore::set_point_target() {
   int64_t target = drive_detail::wrap(static_cast<int64_t>(objects.target_position) + set_point_base_);
   int64_t limit = 0;
   if (min_limit(limit) && target < limit) target = limit;
@@ -276,9 +256,8 @@ int32_t AxisDrive<Manufacturer>::set_point_target() {
   return static_cast<int32_t>(target);
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::start_homing() {
-  const UnitScale u = units();
+void AxisDriveCore::start_homing() {
+  const UnitScale& u = units_;
   HomingConfig config;
   config.fast_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_fast));
   config.slow_speed_pps = saturate_to_int32(u.velocity_pps(objects.homing_speed_slow));
@@ -303,8 +282,7 @@ void AxisDrive<Manufacturer>::start_homing() {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::target_position_written() {
+void AxisDriveCore::target_position_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kProfilePosition) && set_point_taken_in_tick_ &&
       (controlword_ & kCwNewSetPoint) != 0) {
     // An RPDO that maps 6040 before 607A (RPDO 3, ros2_canopen's pp PDO) writes the controlword
@@ -324,12 +302,11 @@ void AxisDrive<Manufacturer>::target_position_written() {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::target_velocity_written() {
+void AxisDriveCore::target_velocity_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kProfileVelocity)) {
     stall_stop_ = false;
     // Bit 10 drops with the write, not a tick later: a poll right after it sees the change.
-    if (units().velocity_pps(objects.target_velocity) != ramp_.velocity()) target_reached_ = false;
+    if (units_.velocity_pps(objects.target_velocity) != ramp_.velocity()) target_reached_ = false;
   }
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncVelocity) && us_since_sync_ >= kSyncAbsentUs) {
     take_mode_change();
@@ -337,23 +314,20 @@ void AxisDrive<Manufacturer>::target_velocity_written() {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::target_torque_written() {
+void AxisDriveCore::target_torque_written() {
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncTorque) && us_since_sync_ >= kSyncAbsentUs) {
     take_mode_change();
     latch_cyclic_set_point();
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::on_sync() {
+void AxisDriveCore::on_sync() {
   us_since_sync_ = 0;
   take_mode_change();
   latch_cyclic_set_point();
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
+void AxisDriveCore::latch_cyclic_set_point() {
   const bool running = pds_.state() == PdsState::kOperationEnabled && pds_.motion() == PdsMotion::kRun;
   if (!running) return;
   if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncPosition)) {
@@ -367,7 +341,7 @@ void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
   } else if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncVelocity)) {
     cyclic_velocity_from_ = ramp_.velocity();
     cyclic_velocity_to_ =
-        units().velocity_pps(static_cast<double>(objects.target_velocity) + static_cast<double>(objects.velocity_offset));
+        units_.velocity_pps(static_cast<double>(objects.target_velocity) + static_cast<double>(objects.velocity_offset));
   } else if (objects.mode == static_cast<int8_t>(Mode::kCyclicSyncTorque)) {
     cyclic_torque_ = limited_torque(int32_t{objects.target_torque} + objects.torque_offset);
   } else {
@@ -379,31 +353,27 @@ void AxisDrive<Manufacturer>::latch_cyclic_set_point() {
 
 // --- The tick ---------------------------------------------------------------------------------
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::follow_actual_motion() {
+void AxisDriveCore::follow_actual_motion() {
   ramp_.set_state(actual_position_, actual_velocity_pps_);
 }
 
-template <class Manufacturer>
-int32_t AxisDrive<Manufacturer>::limited_torque(int32_t torque) const {
+int32_t AxisDriveCore::limited_torque(int32_t torque) const {
   const int32_t limit = objects.max_torque;
   if (limit == 0) return torque;
   return torque > limit ? limit : torque < -limit ? -limit : torque;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::take_mode_change() {
+void AxisDriveCore::take_mode_change() {
   if (objects.mode == active_mode_) return;
   const int8_t from = active_mode_;
   active_mode_ = objects.mode;
   on_mode_change(from, active_mode_);
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::on_mode_change(int8_t from, int8_t to) {
+void AxisDriveCore::on_mode_change(int8_t from, int8_t to) {
   if (from == static_cast<int8_t>(Mode::kHoming) && homing_.active()) homing_.stop();
   // A servo's new mode starts from where the motor is and how fast it turns (bumpless).
-  if constexpr (Manufacturer::kServo) follow_actual_motion();
+  if (servo_) follow_actual_motion();
   cyclic_latched_ = false;
   cyclic_torque_ = 0;
   halted_ = false;
@@ -424,8 +394,7 @@ void AxisDrive<Manufacturer>::on_mode_change(int8_t from, int8_t to) {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
+void AxisDriveCore::step(const AxisInputs& inputs, uint32_t dt_us) {
   const double dt_s = static_cast<double>(dt_us) * 1e-6;
   // A stall flag the drive asked to clear is still set in this tick's readings: not a new stall.
   AxisInputs in = inputs;
@@ -450,7 +419,7 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   demand_.position_usteps = ramp_.position();
   demand_.velocity_exact_pps = ramp_.velocity();
   // A stepper takes whole steps per second; a servo the exact value.
-  if constexpr (!Manufacturer::kServo) demand_.velocity_pps = static_cast<int32_t>(std::lround(ramp_.velocity()));
+  if (!servo_) demand_.velocity_pps = static_cast<int32_t>(std::lround(ramp_.velocity()));
   demand_.power_enabled = pds_.power_enabled();
   const PdsState state = pds_.state();
   demand_.brake_released_request = pds_.power_enabled() &&
@@ -459,8 +428,7 @@ void AxisDrive<Manufacturer>::step(const AxisInputs& inputs, uint32_t dt_us) {
   demand_.switch_on_disabled = state == PdsState::kSwitchOnDisabled || state == PdsState::kNotReadyToSwitchOn;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::check_faults(const AxisInputs& inputs) {
+void AxisDriveCore::check_faults(const AxisInputs& inputs) {
   const bool powered = pds_.power_enabled();
   // Following error (6065 with 606A = 0): demand against the encoder.
   if (powered && objects.sensor_selection == 0 && objects.following_error_window != 0 && !following_error_) {
@@ -483,15 +451,14 @@ void AxisDrive<Manufacturer>::check_faults(const AxisInputs& inputs) {
       moving_to_target_ = false;
       pending_ = false;
       if (homing_.active()) homing_.stop();
-      stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
+      stop_ramp(units_.acceleration_pps2(objects.quick_stop_deceleration));
     }
   }
   // A power-stage fault keeps the motor from running: FAULT while the power stage is on.
   if (inputs.power_stage_fault && powered) pds_.fault();
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt_s) {
+void AxisDriveCore::run_pds_motion(const AxisInputs& inputs, double dt_s) {
   // The velocity modes hand the axis a velocity (also while they stop); the others a position.
   // cst hands it a torque while it runs (run_cyclic_torque) and a velocity while it stops.
   const Mode mode = static_cast<Mode>(active_mode_);
@@ -503,7 +470,7 @@ void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt
     case PdsMotion::kHold:
       ramp_.halt();
       // A servo's motor is not held by the demand meanwhile: the demand stays where it is.
-      if constexpr (Manufacturer::kServo) ramp_.set_position(actual_position_);
+      if (servo_) ramp_.set_position(actual_position_);
       if (homing_.active()) homing_.stop();
       moving_to_target_ = false;
       pending_ = false;
@@ -514,7 +481,7 @@ void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt
       break;
     case PdsMotion::kQuickStop:
       if (homing_.active()) homing_.stop();
-      stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
+      stop_ramp(units_.acceleration_pps2(objects.quick_stop_deceleration));
       ramp_.step(ramp_config_, dt_s);
       break;
     case PdsMotion::kSlowDownStop:
@@ -542,8 +509,7 @@ void AxisDrive<Manufacturer>::run_pds_motion(const AxisInputs& inputs, double dt
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_mode(const AxisInputs& inputs, double dt_s) {
+void AxisDriveCore::run_mode(const AxisInputs& inputs, double dt_s) {
   const bool halt = (controlword_ & kCwHalt) != 0;
   const Mode mode = static_cast<Mode>(active_mode_);
   halted_ = halt && mode != Mode::kHoming && mode != Mode::kNone;
@@ -555,7 +521,7 @@ void AxisDrive<Manufacturer>::run_mode(const AxisInputs& inputs, double dt_s) {
     return;
   }
   if (stall_stop_) {
-    stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
+    stop_ramp(units_.acceleration_pps2(objects.quick_stop_deceleration));
     ramp_.step(ramp_config_, dt_s);
     cyclic_latched_ = false;
     return;
@@ -575,8 +541,7 @@ void AxisDrive<Manufacturer>::run_mode(const AxisInputs& inputs, double dt_s) {
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::update_limits(const AxisInputs& inputs) {
+void AxisDriveCore::update_limits(const AxisInputs& inputs) {
   const int32_t position = ramp_.position();
   int64_t limit = 0;
   const bool above = max_limit(limit) && position >= limit;
@@ -600,13 +565,12 @@ void AxisDrive<Manufacturer>::update_limits(const AxisInputs& inputs) {
   report(inputs.left_limit, 3, DriveEvent::kLimitSwitchNegative, v < 0);
 }
 
-template <class Manufacturer>
-bool AxisDrive<Manufacturer>::brake_onto_software_limit(double target_pps, double velocity_ramp_pps2, double dt_s) {
+bool AxisDriveCore::brake_onto_software_limit(double target_pps, double velocity_ramp_pps2, double dt_s) {
   const double v = ramp_.velocity();
   // Towards where the axis moves, or (standing) where the target would take it.
   const double heading = v != 0.0 ? v : target_pps;
   const double direction = heading > 0.0 ? 1.0 : heading < 0.0 ? -1.0 : 0.0;
-  const double quick_stop_pps2 = units().acceleration_pps2(objects.quick_stop_deceleration);
+  const double quick_stop_pps2 = units_.acceleration_pps2(objects.quick_stop_deceleration);
   int64_t limit = 0;
   const bool limited = direction > 0.0 ? max_limit(limit) : direction < 0.0 && min_limit(limit);
   if (!limited || quick_stop_pps2 <= 0.0) return false;
@@ -638,9 +602,8 @@ bool AxisDrive<Manufacturer>::brake_onto_software_limit(double target_pps, doubl
   return true;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_profile_position(const AxisInputs& inputs, double dt_s) {
-  ramp_config_ = profile_config();
+void AxisDriveCore::run_profile_position(const AxisInputs& inputs, double dt_s) {
+  ramp_config_ = profile_;
   update_limits(inputs);
   if ((limit_positive_ && ramp_.velocity() > 0) || (limit_negative_ && ramp_.velocity() < 0)) {
     // A limit switch or software limit ahead: the move ends here.
@@ -649,7 +612,7 @@ void AxisDrive<Manufacturer>::run_profile_position(const AxisInputs& inputs, dou
     stopping_on_limit_ = true;
   }
   if (stopping_on_limit_) {
-    stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
+    stop_ramp(units_.acceleration_pps2(objects.quick_stop_deceleration));
     ramp_.step(ramp_config_, dt_s);
     if (ramp_.standstill()) {
       stopping_on_limit_ = false;
@@ -680,11 +643,10 @@ void AxisDrive<Manufacturer>::run_profile_position(const AxisInputs& inputs, dou
   }
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_profile_velocity(const AxisInputs& inputs, double dt_s) {
-  ramp_config_ = profile_config();
+void AxisDriveCore::run_profile_velocity(const AxisInputs& inputs, double dt_s) {
+  ramp_config_ = profile_;
   // pv: AMAX both ways (6083), no D segments; VMAX bounds nothing but the target itself.
-  const double target = units().velocity_pps(objects.target_velocity);
+  const double target = units_.velocity_pps(objects.target_velocity);
   ramp_config_.vmax_pps = std::fabs(target);
   update_limits(inputs);
   // A limit ahead stops the axis on the quick-stop ramp; a target away from it runs again.
@@ -695,15 +657,14 @@ void AxisDrive<Manufacturer>::run_profile_velocity(const AxisInputs& inputs, dou
     return;  // braking onto a software limit ahead: the axis stops on it, not past it
   }
   if ((limit_positive_ && (target > 0 || v > 0)) || (limit_negative_ && (target < 0 || v < 0))) {
-    stop_ramp(units().acceleration_pps2(objects.quick_stop_deceleration));
+    stop_ramp(units_.acceleration_pps2(objects.quick_stop_deceleration));
   } else {
     ramp_.set_velocity_target(target);
   }
   ramp_.step(ramp_config_, dt_s);
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s) {
+void AxisDriveCore::run_homing(const AxisInputs& inputs, uint32_t dt_us, double dt_s) {
   limit_active_ = inputs.left_limit || inputs.right_limit;
   if (!homing_.active()) {
     if (!ramp_.standstill()) {
@@ -745,8 +706,7 @@ void AxisDrive<Manufacturer>::run_homing(const AxisInputs& inputs, uint32_t dt_u
   if (command.kind != HomingCommand::Kind::kDone) ramp_.step(config, dt_s);
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_cyclic_position(double dt_s) {
+void AxisDriveCore::run_cyclic_position(double dt_s) {
   // csp: linear interpolation from the position at the last SYNC to the new set-point over one
   // interpolation period (60C2); without a new SYNC the axis holds the last set-point.
   const int32_t previous = ramp_.position();
@@ -760,11 +720,10 @@ void AxisDrive<Manufacturer>::run_cyclic_position(double dt_s) {
   }
   const double velocity = dt_s > 0.0 ? static_cast<double>(drive_detail::difference(position, previous)) / dt_s : 0.0;
   ramp_.set_state(position, velocity);
-  ramp_config_ = profile_config();
+  ramp_config_ = profile_;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_cyclic_velocity(const AxisInputs& inputs, double dt_s) {
+void AxisDriveCore::run_cyclic_velocity(const AxisInputs& inputs, double dt_s) {
   // csv: the velocity ramps linearly to the new set-point within one interpolation period.
   const double period = interpolation_period_s();
   motion::EightPointConfig config;
@@ -777,7 +736,7 @@ void AxisDrive<Manufacturer>::run_cyclic_velocity(const AxisInputs& inputs, doub
   // Limits as in pv: a reached limit stops motion towards it on 6085, a software limit ahead is
   // braked onto.
   update_limits(inputs);
-  const double quick_stop_pps2 = units().acceleration_pps2(objects.quick_stop_deceleration);
+  const double quick_stop_pps2 = units_.acceleration_pps2(objects.quick_stop_deceleration);
   const double v = ramp_.velocity();
   const bool switch_ahead =
       (inputs.right_limit && (target > 0 || v > 0)) || (inputs.left_limit && (target < 0 || v < 0));
@@ -792,18 +751,16 @@ void AxisDrive<Manufacturer>::run_cyclic_velocity(const AxisInputs& inputs, doub
   ramp_config_.amax_pps2 = ramp_config_.dmax_pps2 = quick_stop_pps2;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::run_cyclic_torque() {
+void AxisDriveCore::run_cyclic_torque() {
   // cst: the torque set-point goes to the axis as it is (6071 + 60B2, bounded by 6072); the
   // profile generator follows the measured motion, so that a stop or another mode goes on from it.
   follow_actual_motion();
   control_ = DriveControl::kTorque;
   if (!cyclic_latched_) cyclic_torque_ = 0;
-  ramp_config_ = profile_config();
+  ramp_config_ = profile_;
 }
 
-template <class Manufacturer>
-void AxisDrive<Manufacturer>::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_us) {
+void AxisDriveCore::update_target_reached(const AxisInputs& /*inputs*/, uint32_t dt_us) {
   const Mode mode = static_cast<Mode>(active_mode_);
   if (halted_) {
     target_reached_ = ramp_.standstill();
@@ -835,21 +792,12 @@ void AxisDrive<Manufacturer>::update_target_reached(const AxisInputs& /*inputs*/
   }
 }
 
-template <class Manufacturer>
-int32_t AxisDrive<Manufacturer>::position_actual() const { return actual_position_; }
+int32_t AxisDriveCore::position_actual() const { return actual_position_; }
 
-template <class Manufacturer>
-int32_t AxisDrive<Manufacturer>::velocity_actual_value() const {
-  if constexpr (Manufacturer::kServo) return units().velocity_value(actual_velocity_pps_);
-  return units().velocity_value(ramp_.velocity());
-}
-
-template <class Manufacturer>
-uint16_t AxisDrive<Manufacturer>::statusword() const {
+uint16_t AxisDriveCore::statusword() const {
   uint16_t sw = pds_.statusword_state_bits() | kSwRemote;
   if (set_point_refused_) sw |= kSwWarning;
   if (limit_active_) sw |= kSwInternalLimit;
-  sw |= Manufacturer::manufacturer_status_bits(!ramp_.standstill(), negative_direction_);
   const bool enabled = pds_.state() == PdsState::kOperationEnabled;
   if (following_error_) sw |= kSwOms13;  // pp and csp define it; kept in FAULT as the cause
   // The other mode-specific bits mean something only while the drive function runs.
