@@ -369,6 +369,38 @@ TEST(Tmcm1636Canopen, homing_on_the_negative_limit_switch_sets_home_there) {
   EXPECT_NEAR(rig.board->plant()->mechanical_angle_rad() / (2 * M_PI), -0.5, 0.05);
 }
 
+// The drive's positions wrap at 32 bits of 2058 units (65536 per revolution), the axis' at 32 bits
+// of its counts (8192 per revolution): 2^31 units are 2^28 counts. Found by the tmcm1636_canopen
+// fuzz target (fuzz/README.md "Findings"): once the motor had turned past the drive's wrap, the
+// demand position converted as a whole gave the axis a reference 2^29 counts (65536 revolutions)
+// away, and the servo ran towards it. Here homing (35) puts the counter just below the wrap, pv
+// turns the motor past it, and pp takes over where the motor is.
+TEST(Tmcm1636Canopen, a_position_mode_after_the_drive_position_wrapped_holds_the_motor_where_it_is) {
+  Tmcm1636CanopenRig rig(reference_motor());
+  const auto home = static_cast<int32_t>(0x7FFF'F830);  // 2^31 - 2000
+  EXPECT_EQ(rig.download(0x6098, 0, 35, 1), 0u);
+  EXPECT_EQ(rig.download(0x607C, 0, static_cast<uint32_t>(home)), 0u);
+  EXPECT_EQ(rig.download(0x6083, 0, 5000), 0u);
+  rig.enable(6);
+  EXPECT_EQ(rig.download(0x6040, 0, 0x1F, 2), 0u);
+  rig.run_ms(5);
+  EXPECT_NEAR(rig.read_i32(0x6064), home, 100);
+  EXPECT_EQ(rig.download(0x6040, 0, 0x0F, 2), 0u);
+  EXPECT_EQ(rig.download(0x6060, 0, 3, 1), 0u);  // pv at 300 rpm: past 2^31 units within 0.1 s
+  EXPECT_EQ(rig.download(0x60FF, 0, 300), 0u);
+  rig.run_ms(150);
+  EXPECT_EQ(rig.download(0x60FF, 0, 0), 0u);
+  rig.run_ms(100);
+  const int32_t wrapped = rig.read_i32(0x6064);
+  EXPECT_LT(wrapped, 0) << "6064 went past 2^31 - 1";
+  const double before_rev = rig.board->plant()->mechanical_angle_rad() / (2 * M_PI);
+  EXPECT_EQ(rig.download(0x6060, 0, 1, 1), 0u);  // pp: position control from where the motor is
+  rig.run_ms(200);
+  EXPECT_NEAR(rig.board->plant()->mechanical_angle_rad() / (2 * M_PI), before_rev, 0.05);
+  EXPECT_NEAR(rig.read_i32(0x6064), wrapped, 3000);
+  EXPECT_EQ(rig.statusword() & 0x6F, 0x27) << "operation enabled";
+}
+
 TEST(Tmcm1636Canopen, an_undervoltage_faults_the_drive_with_its_emergency_and_0000_when_it_is_gone) {
   Tmcm1636CanopenRig rig(reference_motor());
   rig.enable(3);

@@ -23,6 +23,13 @@ int32_t Tmcm1636Canopen::drive_position(int32_t axis_counts) const { return dire
 
 int32_t Tmcm1636Canopen::axis_position(int32_t drive_units) const { return axis_.axis_position(directed(drive_units)); }
 
+int32_t Tmcm1636Canopen::axis_reference(int32_t drive_units) const {
+  const int32_t from = axis_.ramp_position();
+  const auto delta =
+      static_cast<int32_t>(static_cast<uint32_t>(drive_units) - static_cast<uint32_t>(drive_position(from)));
+  return static_cast<int32_t>(static_cast<uint32_t>(from) + static_cast<uint32_t>(axis_position(delta)));
+}
+
 double Tmcm1636Canopen::drive_velocity(double axis_counts_per_s) const {
   const double v = axis_counts_per_s * frames_.drive_units_per_count;
   return axis_.config.motor_direction != 0 ? -v : v;
@@ -209,7 +216,7 @@ void Tmcm1636Canopen::carry_out(const cia402::AxisDemand& demand) {
   axis_.state.release_brake = demand.brake_released_request ? 1 : 0;
   switch (demand.control) {
     case cia402::DriveControl::kPosition:
-      axis_.follow_position(axis_position(demand.position_usteps), axis_velocity(demand.velocity_exact_pps));
+      axis_.follow_position(axis_reference(demand.position_usteps), axis_velocity(demand.velocity_exact_pps));
       break;
     case cia402::DriveControl::kVelocity: axis_.follow_velocity(axis_velocity(demand.velocity_exact_pps)); break;
     case cia402::DriveControl::kTorque: {

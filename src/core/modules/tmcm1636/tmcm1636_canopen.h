@@ -184,6 +184,13 @@ class Tmcm1636Canopen final : private canopen::NodeApplication {
   // host's direction, 2057) and the axis' (AP 100 = 2080:2 counts per revolution, the motor's).
   int32_t drive_position(int32_t axis_counts) const;
   int32_t axis_position(int32_t drive_units) const;
+  // The drive's demand position as the axis' position reference: its distance from where the
+  // reference stands, taken in the drive's frame and converted, added to the reference. Both
+  // counters wrap at 32 bits, the drive's in 2058 units and the axis' in its counts, so an absolute
+  // conversion loses turns: with 2058 = 65536 and 2080:2 = 8192, 2^31 units are 2^28 counts, and an
+  // axis beyond 32768 revolutions from its zero got a reference 65536 revolutions away (fuzz/README.md
+  // "Findings"). A distance converts alike in any turn.
+  int32_t axis_reference(int32_t drive_units) const;
   double drive_velocity(double axis_counts_per_s) const;
   double axis_velocity(double drive_units_per_s) const;
   int32_t directed(int32_t value) const {
