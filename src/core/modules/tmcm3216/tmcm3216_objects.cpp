@@ -18,12 +18,10 @@ using canopen::DataType;
 using canopen::EntryBinding;
 using canopen::EntryInfo;
 using canopen::ObjectCode;
-using canopen::SdoAbort;
 using canopen::StorageGroup;
 using Row = Tmcm3216::Row;
 using Binding = EntryBinding<Tmcm3216>;
 
-constexpr int64_t kU8Max = 0xFF;
 constexpr int64_t kU32Max = 0xFFFF'FFFF;
 
 // One row. `entry` names are the sub-index names; `object` the index name.
@@ -39,7 +37,6 @@ constexpr Row var(uint16_t index, std::string_view name, DataType type, Access a
                   int64_t default_value, Binding binding = {}, StorageGroup storage = StorageGroup::kNone) {
   return row(index, 0, ObjectCode::kVar, name, name, type, access, min, max, default_value, binding, storage);
 }
-
 
 // --- The communication objects (manual chapter 3), on the node -----------------------------------
 
