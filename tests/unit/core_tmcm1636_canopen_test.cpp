@@ -401,6 +401,34 @@ TEST(Tmcm1636Canopen, a_position_mode_after_the_drive_position_wrapped_holds_the
   EXPECT_EQ(rig.statusword() & 0x6F, 0x27) << "operation enabled";
 }
 
+// With the power stage off the ideal motor stands where it is. Found by the tmcm1636_canopen fuzz
+// target (fuzz/README.md "Findings"): a drive enabled and quick-stopped between two of its runs
+// goes to SWITCH ON DISABLED in one run without powering the axis, and the demand it held then
+// (here stale: 2080:2 changed meanwhile, so the motor's 600 counts are no longer its 4800 units)
+// was handed to the unpowered axis, which moved the ideal motor there.
+TEST(Tmcm1636Canopen, the_ideal_motor_stands_while_the_power_stage_is_off) {
+  Tmcm1636CanopenRig rig;
+  EXPECT_EQ(rig.download(0x6081, 0, 1000), 0u);
+  EXPECT_EQ(rig.download(0x6083, 0, 5000), 0u);
+  rig.enable(8);  // csp: 607A taken at once
+  EXPECT_EQ(rig.download(0x607A, 0, 4800), 0u);
+  rig.run_ms(5);
+  EXPECT_EQ(rig.device->axis().actual_position(), 600);  // 8192 counts, 65536 units per revolution
+  EXPECT_EQ(rig.download(0x6040, 0, 0x06, 2), 0u);       // shutdown: the power stage off
+  rig.run_ms(2);
+  EXPECT_EQ(rig.device->axis().state.driver_enabled, 0);
+  // In one instant: enable operation, another encoder resolution, quick stop (605A = 2: then
+  // SWITCH ON DISABLED).
+  EXPECT_EQ(rig.download(0x6040, 0, 0x0F, 2), 0u);
+  EXPECT_EQ(rig.download(0x2080, 2, 62817, 2), 0u);
+  EXPECT_EQ(rig.download(0x6040, 0, 0x02, 2), 0u);
+  rig.run_ms(3);
+  EXPECT_EQ(rig.statusword() & 0x4F, 0x40);  // SWITCH ON DISABLED
+  EXPECT_EQ(rig.device->axis().state.driver_enabled, 0);
+  EXPECT_EQ(rig.device->axis().actual_position(), 600);
+  EXPECT_EQ(rig.read_i32(0x6064), 626);  // 600 counts at 62817 per revolution
+}
+
 TEST(Tmcm1636Canopen, an_undervoltage_faults_the_drive_with_its_emergency_and_0000_when_it_is_gone) {
   Tmcm1636CanopenRig rig(reference_motor());
   rig.enable(3);

@@ -214,6 +214,11 @@ void Tmcm1636Canopen::carry_out(const cia402::AxisDemand& demand) {
     axis_.set_driver_enabled(driver_enabled_);
   }
   axis_.state.release_brake = demand.brake_released_request ? 1 : 0;
+  // With the power stage off there is nothing to follow: a servo's reference follows its coasting
+  // motor by itself and the ideal motor stands. A demand handed over then moved the ideal motor
+  // without power: a drive enabled and quick-stopped between two runs ends in SWITCH ON DISABLED
+  // within one run, holding the demand it had (fuzz/README.md "Findings").
+  if (!demand.power_enabled) return;
   switch (demand.control) {
     case cia402::DriveControl::kPosition:
       axis_.follow_position(axis_reference(demand.position_usteps), axis_velocity(demand.velocity_exact_pps));
