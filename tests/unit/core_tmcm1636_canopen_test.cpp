@@ -429,6 +429,29 @@ TEST(Tmcm1636Canopen, the_ideal_motor_stands_while_the_power_stage_is_off) {
   EXPECT_EQ(rig.read_i32(0x6064), 626);  // 600 counts at 62817 per revolution
 }
 
+// Homing 35 attains when the controlword is written, and the position the drive assigns is the
+// axis' counter from its next run on, before that run reads it: 6064 reads the home offset from
+// the write on, and the following error is measured against it. Found while reading a
+// tmcm1636_canopen fuzz input (fuzz/README.md "Findings"): the run after the write read the
+// counter as it was before the homing, 6064 showed it for a millisecond, and a following-error
+// window smaller than the home offset's distance faulted the drive.
+TEST(Tmcm1636Canopen, homing_35_takes_the_home_offset_at_once_without_a_following_error) {
+  Tmcm1636CanopenRig rig;
+  EXPECT_EQ(rig.download(0x6098, 0, 35, 1), 0u);
+  EXPECT_EQ(rig.download(0x607C, 0, 100000), 0u);
+  EXPECT_EQ(rig.download(0x6065, 0, 1000), 0u);
+  rig.enable(6);
+  EXPECT_EQ(rig.download(0x6040, 0, 0x1F, 2), 0u);
+  EXPECT_EQ(rig.read_i32(0x6064), 100000);
+  for (int ms = 0; ms < 3; ++ms) {
+    rig.run_ms(1);
+    EXPECT_EQ(rig.read_i32(0x6064), 100000) << ms + 1 << " ms after the write";
+  }
+  EXPECT_EQ(rig.statusword() & 0x6F, 0x27) << "operation enabled, no following error";
+  EXPECT_NE(rig.statusword() & (1u << 12), 0u) << "homing attained";
+  EXPECT_TRUE(frames_with_id(rig.sent, 0x81).empty()) << "no EMCY";
+}
+
 TEST(Tmcm1636Canopen, an_undervoltage_faults_the_drive_with_its_emergency_and_0000_when_it_is_gone) {
   Tmcm1636CanopenRig rig(reference_motor());
   rig.enable(3);
