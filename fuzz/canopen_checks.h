@@ -1,5 +1,7 @@
 // Checks shared by the CANopen fuzz targets: the SDO client's view of every transfer and the
-// object dictionary's ranges.
+// object dictionary's ranges. Each works on any module with a canopen::Node and a TableDictionary
+// (`Device`: the TMCM-3216, the TMCM-1636's CANopen firmware): node(), node_id(), nmt_state() and
+// dictionary().
 #pragma once
 
 #include <algorithm>
@@ -35,15 +37,17 @@ inline uint16_t crc16_bitwise(const uint8_t* data, size_t length) {
   return crc;
 }
 
-// The objects of the TMCM-3216's dictionary by index and sub-index, for the checks' own lookups:
+// The objects of a module's dictionary by index and sub-index, for the checks' own lookups:
 // what TableDictionary::find answers, from a table sorted once per process (the rows and the axis
 // count are constants) and searched without libFuzzer's tracing. Looking up through find() for
 // every snapshot and read-back of the SDO client view was a seventh of canopen_pdo's time; the
 // server's own lookups stay find(). The table is checked when it is built: every entry is what
-// find() gives, and every index and sub-index that find() knows is in it.
+// find() gives, and every index and sub-index that find() knows is in it. One per module type and
+// process.
 class ObjectLookup {
  public:
-  static const ObjectLookup& of(Tmcm3216& device) {
+  template <class Device>
+  static const ObjectLookup& of(Device& device) {
     static const ObjectLookup lookup(device);
     FUZZ_CHECK(device.dictionary().rows().data() == lookup.rows_, "ObjectLookup: another object table");
     return lookup;
@@ -72,7 +76,8 @@ class ObjectLookup {
     canopen::ObjectRef ref;
   };
 
-  explicit ObjectLookup(Tmcm3216& device) {
+  template <class Device>
+  explicit ObjectLookup(Device& device) {
     auto& dictionary = device.dictionary();
     const auto rows = dictionary.rows();
     rows_ = rows.data();
@@ -121,7 +126,8 @@ class ObjectLookup {
 // default) encoded in the type's size, as TableDictionary::read does (value(), encode_value()),
 // untraced. Checked, not assumed: on the first call of a process and then every 2^16th, the bytes
 // must equal what read() gives.
-FUZZ_UNTRACED inline size_t read_numeric(Tmcm3216& device, const canopen::ObjectRef& ref, uint8_t (&bytes)[8]) {
+template <class Device>
+FUZZ_UNTRACED size_t read_numeric(Device& device, const canopen::ObjectRef& ref, uint8_t (&bytes)[8]) {
   static uint64_t calls = 0;
   auto& dictionary = device.dictionary();
   const auto get = dictionary.rows()[ref.row].binding.get;
@@ -138,7 +144,7 @@ FUZZ_UNTRACED inline size_t read_numeric(Tmcm3216& device, const canopen::Object
   return length;
 }
 
-// The SDO client's side of the TMCM-3216's server (CiA-301 7.2.4.3): the transfer state as the
+// The SDO client's side of a module's server (CiA-301 7.2.4.3): the transfer state as the
 // client sees it from its requests and the server's responses, against which every response is
 // checked. Around each step of a target: before(frame or nullptr, elapsed µs), then the step
 // (receive, process), then after(every frame the device sent).
@@ -168,9 +174,10 @@ FUZZ_UNTRACED inline size_t read_numeric(Tmcm3216& device, const canopen::Object
 //   response without a request); an NMT or LSS reset ends it silently.
 // - An expedited download acknowledged without abort reads back as the written value (a numeric
 //   read-write object written with its type's size); an aborted one changes nothing.
+template <class Device>
 class SdoClientView {
  public:
-  explicit SdoClientView(Tmcm3216& device) : device_(device) {}
+  explicit SdoClientView(Device& device) : device_(device) {}
 
   void before(const can::CanFrame* frame, uint32_t elapsed_us) {
     node_ = device_.node_id();
@@ -208,7 +215,7 @@ class SdoClientView {
         (nmt == canopen::NmtState::kPreOperational || nmt == canopen::NmtState::kOperational);
     if (out.empty()) {
       // An NMT command, an LSS reset or a heartbeat timeout ended the transfer without a frame.
-      if (device_.sdo().state() == canopen::SdoState::kIdle) state_ = State::kIdle;
+      if (device_.node().sdo().state() == canopen::SdoState::kIdle) state_ = State::kIdle;
       FUZZ_CHECK(!(state_ != State::kIdle && idle_us_ >= canopen::SdoServer::kTimeoutUs && serving_before_ &&
                    serving_after && elapsed_us_ > 0),
                  "a transfer idle for %llu us was not aborted", static_cast<unsigned long long>(idle_us_));
@@ -384,9 +391,11 @@ class SdoClientView {
   }
 
   // Not plain: the store and restore commands (1010, 1011, 2706 sub 1) take a signature, and a read
-  // gives what the device can store or restore (CiA-301 7.5.2.13/14), not the last signature.
+  // gives what the device can store or restore (CiA-301 7.5.2.13/14), not the last signature; the
+  // TMCM-1636 CANopen firmware's 5FFF (Enter Boot Mode) takes a key and reads 0
+  // (docs/tmcm-1636-canopen.md). No TMCM-3216 object has that index.
   static bool plain(const canopen::EntryInfo& info) {
-    return info.index != 0x1010 && info.index != 0x1011 && info.index != 0x2706;
+    return info.index != 0x1010 && info.index != 0x1011 && info.index != 0x2706 && info.index != 0x5FFF;
   }
 
   void download_segment(const uint8_t* d, const Frames& out) {
@@ -613,7 +622,7 @@ class SdoClientView {
     state_ = State::kUploadBlockEnd;
   }
 
-  Tmcm3216& device_;
+  Device& device_;
   uint8_t node_ = 0;
   bool serving_before_ = false;
   bool has_request_ = false;
@@ -650,7 +659,8 @@ FUZZ_UNTRACED inline int64_t as_uploaded(canopen::DataType type, int64_t value) 
 // Every writable numeric object of every axis as TableDictionary::read and decode_value give it
 // (the row itself, as find() answers for its index and sub-index: the dictionary's unit tests
 // hold find() to that), in table order. The reference check_dictionary_ranges is held to.
-inline std::vector<int64_t> writable_values_as_read(Tmcm3216& device) {
+template <class Device>
+std::vector<int64_t> writable_values_as_read(Device& device) {
   std::vector<int64_t> values;
   auto& dictionary = device.dictionary();
   const auto rows = dictionary.rows();
@@ -677,7 +687,8 @@ inline std::vector<int64_t> writable_values_as_read(Tmcm3216& device) {
 // traced a third of the CANopen targets' time and guides nothing, the values coming from the
 // module. fuzz/README.md, Speed. The shortcut is checked, not assumed: on the first call of a
 // process and then every 2^16th, the values must equal those that read() gives.
-FUZZ_UNTRACED inline void check_dictionary_ranges(Tmcm3216& device) {
+template <class Device>
+FUZZ_UNTRACED void check_dictionary_ranges(Device& device) {
   static uint64_t calls = 0;
   const bool compare = calls++ % kRigComparisonPeriod == 0;
   std::vector<int64_t> checked;

@@ -234,7 +234,7 @@ class PdoFuzzer {
   const Tables& tables_;
   const std::vector<Target>& pdo_parameters_ = tables_.pdo_parameters;
   const std::vector<uint32_t>& mappable_ = tables_.mappable;
-  fuzz::SdoClientView client_{device_};
+  fuzz::SdoClientView<fuzz::Tmcm3216> client_{device_};
 };
 
 }  // namespace

@@ -206,8 +206,10 @@ using Tmcm3216 = modules::tmcm3216::Tmcm3216;
 using Tmcm3216Nvm = board::RamNonVolatileMemory<Tmcm3216::kNvmSize>;
 
 // Every readable numeric object of every axis (its SDO abort where it has none) and the EEPROM
-// image: what a fresh TMCM-3216 rig is compared by.
-inline std::vector<int64_t> dictionary_state(Tmcm3216& device, const Tmcm3216Nvm& nvm) {
+// image: what a fresh rig of a CANopen module (the TMCM-3216, the TMCM-1636's CANopen firmware) is
+// compared by.
+template <class Device, class Nvm>
+std::vector<int64_t> dictionary_state(Device& device, const Nvm& nvm) {
   std::vector<int64_t> values;
   auto& dictionary = device.dictionary();
   const auto rows = dictionary.rows();
@@ -225,7 +227,7 @@ inline std::vector<int64_t> dictionary_state(Tmcm3216& device, const Tmcm3216Nvm
   }
   values.push_back(device.node_id());
   values.push_back(static_cast<int64_t>(device.nmt_state()));
-  values.push_back(device.restarting());
+  values.push_back(device.node().restarting());
   values.insert(values.end(), nvm.data(), nvm.data() + nvm.size());
   return values;
 }

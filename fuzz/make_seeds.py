@@ -584,6 +584,7 @@ def sdo_seeds():
     canopen_lss_seeds()
     tmcl_engine_seeds()
     tmcl_can_frame_seeds()
+    tmcm1636_canopen_seeds()
 
 
 # 2026-11-27: the eight_point_ramp campaign's findings (fuzz/README.md "Findings").
@@ -625,6 +626,163 @@ TMCM3216_DRIVE_FINDINGS = [
 TMCM142_ENGINE_FINDINGS = [
     ("finding_2026_11_27_unit_mode_1_acceleration_beyond_range", "DX/34wQVE8e7T4sFJFE="),
 ]
+
+
+# Inputs of the tmcm1636_canopen findings (fuzz/README.md "Findings"), kept byte for byte.
+TMCM1636_CANOPEN_FINDINGS = [
+    # 2026-12-07: 2703 sub 1 acknowledged a write without a mask and read 0
+    # (Tmcm1636Canopen.physical_outputs_read_back_as_written_and_the_mask_decides_what_switches).
+    ("finding_2026_12_07_2703_sub1_reads_back", "ASMAIdylBCEA"),
+    # 2026-12-07: csv at 1.6e9 rpm took the axis past the drive's 32-bit wrap; the demand converted whole
+    # then moved the ideal motor 2^29 counts with the driver off
+    # (Tmcm1636Canopen.a_position_mode_after_the_drive_position_wrapped_holds_the_motor_where_it_is).
+    ("finding_2026_12_07_demand_past_the_drive_wrap", "z8F5Fv////////+aF9WN8wEMAgIAAAECAD0bRJ/8AAAA3TKixvT0"),
+    # 2026-12-07: enable, 2080:2 and a quick stop between two drive runs; the stale demand moved the unpowered
+    # ideal motor (Tmcm1636Canopen.the_ideal_motor_stands_while_the_power_stage_is_off).
+    ("finding_2026_12_07_demand_handed_to_the_unpowered_axis", "93cTAk2hAgAFGRIoNAEZEgwAACADEgwAIAMBBQEAMw=="),
+    # 2026-12-07: homing 35 attained at the write, then disable voltage; the counter set to the home offset with
+    # the driver off (Tmcm1636Canopen.homing_35_takes_the_home_offset_at_once_without_a_following_error).
+    ("finding_2026_12_07_homing_35_then_disable_voltage", "/w0DARIHAAESEgMBDwEEDAEAAAEAEg=="),
+]
+
+
+def tmcm1636_canopen_seeds():
+    # fuzz/tmcm1636_canopen.cpp (keep these lists as its kDriveObjects, kControlwords, kModes,
+    # kHomingMethods): u8 the bring-up (bits 0-3 the mode, index into MODES, 11..15 none; 4 the
+    # profile; 5 enable; 6 no NMT start), u8 the motor (bits 0-2 all set: the physical one), then per
+    # step int(0..14): 0 NMT (int(0..6) of 01 01 01 80 02 82 81, bool: all nodes), 1-3 a drive
+    # object (its index in DRIVE, the sub-index in its range, then the value: a controlword, mode or
+    # homing method by its index, else bool -> -200000..200000, else any INTEGER32), 4 any object
+    # of the table (not used here: it picks from the table's rows), 5 a raw SDO request (length as
+    # the CANopen targets', 8 bytes, bool: a real object's index, not used here), 6 an RPDO
+    # (int(0..3) RPDO 1..4, length: int(0..7) == 0 -> 0..8, else 2, 3 or 6; 8 bytes; the
+    # controlword by its index), 7 SYNC (int(0..7) == 0 -> one byte; a byte), 8 node guarding
+    # (int(0..7) == 0 -> another node 0..127; int(0..7) != 0 -> remote; length 0..8; int(0..3) of
+    # 00 04 05 7F), 9 LSS (length, 8 bytes, bool -> int(0..14) of the commands), 10 any identifier,
+    # 11 a board input (not used here), 12-14 ticks (1..1000).
+    DRIVE = [(0x6040, 0, 0), (0x6040, 0, 0), (0x6040, 0, 0), (0x6060, 0, 0), (0x6060, 0, 0), (0x607A, 0, 0),
+             (0x60FF, 0, 0), (0x6071, 0, 0), (0x6081, 0, 0), (0x6083, 0, 0), (0x6084, 0, 0), (0x6085, 0, 0),
+             (0x6098, 0, 0), (0x6099, 1, 2), (0x609A, 0, 0), (0x607C, 0, 0), (0x605A, 0, 0), (0x6072, 0, 0),
+             (0x60C2, 1, 2), (0x6065, 0, 0), (0x6067, 0, 0), (0x607D, 1, 2), (0x2005, 0, 0), (0x2057, 0, 0),
+             (0x2058, 0, 0), (0x2080, 2, 2)]
+    CONTROLWORDS = [0x0006, 0x0007, 0x000F, 0x0000, 0x0002, 0x0007, 0x0080, 0x001F, 0x000F, 0x010F, 0x005F, 0x003F,
+                    0x000B, 0x008F, 0x002F]
+    MODES = [1, 3, 6, 8, 9, 10, 0, -1, 2, 7, 4]
+    METHODS = [17, 18, 19, 21, 35, 0, 1, 37, -1]
+    PP, PV, HM, CSP, CSV, CST = range(6)
+    PROFILE, ENABLE, NO_START = 0x10, 0x20, 0x40
+
+    class Steps:
+        def __init__(self, bring_up, physical=False):
+            self.f = Fdp().u8(bring_up).u8(0xFF if physical else 0x00)
+
+        def nmt(self, command, all_nodes=True):
+            self.f.int(0, 0, 14).int([0x01, 0x01, 0x01, 0x80, 0x02, 0x82, 0x81].index(command), 0, 6).bool(all_nodes)
+            return self
+
+        def write(self, index, value, sub=0):
+            i = next(n for n, (x, lo, hi) in enumerate(DRIVE) if x == index and lo <= sub <= hi)
+            _, lo, hi = DRIVE[i]
+            self.f.int(1, 0, 14).int(i, 0, len(DRIVE) - 1).int(sub, lo, hi)
+            if index == 0x6040:
+                self.f.int(CONTROLWORDS.index(value), 0, len(CONTROLWORDS) - 1)
+            elif index == 0x6060:
+                self.f.int(MODES.index(value), 0, len(MODES) - 1)
+            elif index == 0x6098:
+                self.f.int(METHODS.index(value), 0, len(METHODS) - 1)
+            elif -200_000 <= value <= 200_000:
+                self.f.bool(True).int(value, -200_000, 200_000)
+            else:
+                self.f.bool(False).i32(value)
+            return self
+
+        def sdo(self, *data, length=8):
+            self.f.int(5, 0, 14).length_and_eight(data, length).bool(False)
+            return self
+
+        def rpdo(self, number, controlword, data=(), length=None):
+            self.f.int(6, 0, 14).int(number - 1, 0, 3)
+            if length is None:
+                length = {1: 2, 2: 3, 3: 6, 4: 6}[number]
+            if length in (2, 3, 6):
+                self.f.int(1, 0, 7).int([2, 3, 6].index(length), 0, 2)
+            else:
+                self.f.int(0, 0, 7).int(length, 0, 8)
+            self.f.eight([0, 0] + list(data)).int(CONTROLWORDS.index(controlword), 0, len(CONTROLWORDS) - 1)
+            return self
+
+        def sync(self):
+            self.f.int(7, 0, 14).int(1, 0, 7).u8(0)
+            return self
+
+        def guard(self, remote=True):
+            self.f.int(8, 0, 14).int(1, 0, 7).int(1 if remote else 0, 0, 7).int(0, 0, 8).int(0, 0, 3)
+            return self
+
+        def lss(self, command, *data):
+            self.f.int(9, 0, 14).length_and_eight([command] + list(data)).bool(False)
+            return self
+
+        def frame(self, cob_id, data, rtr=False):
+            self.f.int(10, 0, 14).int(cob_id, 0, 0x7FF).int(0 if rtr else 1, 0, 7).int(len(data), 0, 8).eight(data)
+            return self
+
+        def ticks(self, n):
+            while n > 0:
+                self.f.int(12, 0, 14).int(min(n, 1000), 1, 1000)
+                n -= 1000
+            return self
+
+    def seed(name, steps):
+        write("tmcm1636_canopen", name, steps.f.data())
+
+    # The sequences of tests/unit/core_tmcm1636_canopen_test.cpp and PyTrinamic's TMCM-1636 CANopen
+    # examples (tests/integration/test_tmcm1636_canopen_examples.py), on the ideal motor and on the
+    # physical one.
+    def pv_run(physical):
+        return (Steps(PV | PROFILE | ENABLE, physical).write(0x60FF, 500).ticks(1500).write(0x60FF, -300).ticks(500)
+                .write(0x6040, 0x010F).ticks(300).write(0x6040, 0x000F).write(0x6040, 0x0002).ticks(500)
+                .sdo(0x40, 0x41, 0x60, 0).sdo(0x40, 0x6C, 0x60, 0))
+    seed("pv_run", pv_run(False))
+    seed("pv_run_physical", pv_run(True))
+
+    def pp_move(physical):
+        return (Steps(PP | PROFILE | ENABLE, physical).write(0x607A, 100_000).write(0x6040, 0x001F).ticks(1200)
+                .write(0x6040, 0x000F).write(0x607A, -50_000).write(0x6040, 0x005F).ticks(1500)
+                .write(0x6040, 0x000F).write(0x607A, 40_000).write(0x6040, 0x003F).ticks(1000)
+                .sdo(0x40, 0x64, 0x60, 0).sdo(0x40, 0x41, 0x60, 0))
+    seed("pp_move", pp_move(False))
+    seed("pp_move_physical", pp_move(True))
+    csp = Steps(CSP | PROFILE | ENABLE)
+    for k in range(1, 30):
+        csp.write(0x607A, 600 * k).ticks(20)
+    seed("csp_by_sdo", csp.write(0x60C2, 5, sub=1).sync().write(0x607A, 20_000).sync().ticks(200))
+    seed("cst", Steps(CST | PROFILE | ENABLE).write(0x6071, 300).ticks(400).write(0x6072, 100).write(0x6071, -500)
+         .ticks(400).write(0x6040, 0x0002).ticks(400).write(0x6040, 0x0000))
+    seed("homing", Steps(HM | PROFILE).write(0x2005, 0).write(0x6098, 17).write(0x6040, 0x0006)
+         .write(0x6040, 0x0007).write(0x6040, 0x000F).write(0x6040, 0x001F).ticks(1000).write(0x6040, 0x000F)
+         .write(0x6098, 35).write(0x607C, 1234).write(0x6040, 0x001F).ticks(200).sdo(0x40, 0x64, 0x60, 0)
+         .write(0x6040, 0x0080).write(0x6040, 0x0000))
+    save, load = le(SAVE), le(LOAD)
+    seed("store_restore", Steps(PV | NO_START).sdo(0x23, 0x03, 0x20, 0, *le(1500)).sdo(0x23, 0x83, 0x60, 0, *le(700))
+         .sdo(0x23, 0x10, 0x10, 3, *save).sdo(0x23, 0x10, 0x10, 3, *le(0x1234)).nmt(0x81).sdo(0x40, 0x03, 0x20, 0)
+         .sdo(0x23, 0x11, 0x10, 1, *load).sdo(0x23, 0x06, 0x27, 1, *save).sdo(0x2F, 0x05, 0x27, 0, 5)
+         .sdo(0x23, 0x10, 0x10, 2, *save).nmt(0x81).sdo(0x23, 0x11, 0x10, 1, *load).nmt(0x81))
+    seed("node_guarding", Steps(0x0F).sdo(0x2B, 0x0C, 0x10, 0, *le(20, 2)).sdo(0x2F, 0x0D, 0x10, 0, 3).guard()
+         .ticks(40).guard().guard().ticks(1000).guard().nmt(0x02).guard().nmt(0x82).guard().ticks(20).guard()
+         .sdo(0x2B, 0x17, 0x10, 0, *le(10, 2)).guard().ticks(30).guard(remote=False))
+    seed("lss_and_other_frames", Steps(PV | PROFILE | ENABLE).lss(0x04, 1).lss(0x5A).lss(0x5E).lss(0x11, 5)
+         .lss(0x40, 0x86, 0x02).frame(0x7E5, [0x04, 0x00]).frame(0x000, [0x81, 0x01]).sync().rpdo(1, 0x000F)
+         .rpdo(4, 0x000F, le(100)).rpdo(3, 0x001F, le(5000)).rpdo(2, 0x000F, [1]).ticks(200))
+    seed("outputs_and_boot_mode", Steps(0x0F | NO_START).sdo(0x23, 0x03, 0x27, 2, *le(1)).sdo(0x23, 0x03, 0x27, 1, *le(3))
+         .sdo(0x23, 0x03, 0x27, 1, *le(SAVE)).sdo(0x40, 0x03, 0x27, 1).sdo(0x23, 0xFF, 0x5F, 0, *le(0x12345678))
+         .sdo(0x23, 0xFF, 0x5F, 0, *le(7)).sdo(0x40, 0xFF, 0x5F, 0))
+    rng = random.Random(1636)
+    for n in (64, 256, 1024, 4096):
+        for k in range(2):
+            write("tmcm1636_canopen", f"random_{n}_{k}", bytes(rng.randrange(256) for _ in range(n)))
+    for name, text in TMCM1636_CANOPEN_FINDINGS:
+        write("tmcm1636_canopen", name, base64.b64decode(text))
 
 def engine_seeds():
     # The ramp, homing, TMCM-3216 drive and TMCM-142 engine targets read FuzzedDataProvider input
