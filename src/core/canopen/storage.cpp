@@ -54,43 +54,46 @@ bool StorageImage::find(const uint8_t* image, size_t size, uint16_t index, uint8
   return false;
 }
 
-SdoAbort ObjectStorage::save(const StorageSelection& selection) {
-  size_t count = keep_unselected(selection);
+template <class Visit>
+bool ObjectStorage::for_each_selected(const StorageSelection& selection, const Visit& visit) {
   for (size_t row = 0; row < dictionary_.row_count(); ++row) {
     const EntryInfo& info = dictionary_.row_info(row);
     if (info.storage == StorageGroup::kNone || !is_numeric(info.type)) continue;
     for (uint8_t axis = 0; axis < dictionary_.axes_of(info); ++axis) {
       if (!selection.contains(info.storage, axis)) continue;
-      const ObjectRef ref = dictionary_.ref(row, axis);
-      const int64_t value = dictionary_.value(ref);
-      // "$NODEID+" objects at their default follow the node ID: nothing to store.
-      if (info.default_plus_node_id && value == dictionary_.default_value(info, axis)) continue;
-      if (StorageImage::size_for(count + 1) > capacity()) return SdoAbort::kOutOfMemory;
-      StorageImage::put_record(scratch_, count++, StorageRecord{ref.index, info.sub, static_cast<uint32_t>(value)});
+      if (!visit(info, dictionary_.ref(row, axis))) return false;
     }
   }
-  return commit(count);
+  return true;
+}
+
+SdoAbort ObjectStorage::save(const StorageSelection& selection) {
+  size_t count = keep_unselected(selection);
+  const bool fits = for_each_selected(selection, [&](const EntryInfo& info, const ObjectRef& ref) {
+    const int64_t value = dictionary_.value(ref);
+    // "$NODEID+" objects at their default follow the node ID: nothing to store.
+    if (info.default_plus_node_id && value == dictionary_.default_value(info, ref.axis)) return true;
+    if (StorageImage::size_for(count + 1) > capacity()) return false;
+    StorageImage::put_record(scratch_, count++, StorageRecord{ref.index, info.sub, static_cast<uint32_t>(value)});
+    return true;
+  });
+  return fits ? commit(count) : SdoAbort::kOutOfMemory;
 }
 
 void ObjectStorage::load(const StorageSelection& selection) {
   const uint8_t* image = nvm_.data();
   const size_t size = nvm_.size();
-  for (size_t row = 0; row < dictionary_.row_count(); ++row) {
-    const EntryInfo& info = dictionary_.row_info(row);
-    if (info.storage == StorageGroup::kNone || !is_numeric(info.type)) continue;
-    for (uint8_t axis = 0; axis < dictionary_.axes_of(info); ++axis) {
-      if (!selection.contains(info.storage, axis)) continue;
-      const ObjectRef ref = dictionary_.ref(row, axis);
-      uint32_t stored = 0;
-      int64_t value = dictionary_.default_value(info, axis);
-      if (StorageImage::find(image, size, ref.index, info.sub, stored)) {
-        value = is_signed(info.type) ? static_cast<int32_t>(stored) : static_cast<int64_t>(stored);
-        // A damaged or foreign record never puts an object out of its range.
-        if (check_range(info, value) != SdoAbort::kNone) value = dictionary_.default_value(info, axis);
-      }
-      dictionary_.store(ref, value);
+  for_each_selected(selection, [&](const EntryInfo& info, const ObjectRef& ref) {
+    uint32_t stored = 0;
+    int64_t value = dictionary_.default_value(info, ref.axis);
+    if (StorageImage::find(image, size, ref.index, info.sub, stored)) {
+      value = is_signed(info.type) ? static_cast<int32_t>(stored) : static_cast<int64_t>(stored);
+      // A damaged or foreign record never puts an object out of its range.
+      if (check_range(info, value) != SdoAbort::kNone) value = dictionary_.default_value(info, ref.axis);
     }
-  }
+    dictionary_.store(ref, value);
+    return true;
+  });
 }
 
 size_t ObjectStorage::keep_unselected(const StorageSelection& selection) {

@@ -82,6 +82,10 @@ class ObjectStorage {
 
  private:
   size_t capacity() const { return scratch_size_ < nvm_.size() ? scratch_size_ : nvm_.size(); }
+  // `visit(info, ref)` for every stored numeric object the selection holds, each axis' copy; stops
+  // at the first false (then returns false).
+  template <class Visit>
+  bool for_each_selected(const StorageSelection& selection, const Visit& visit);
   // Copies the records of the image that the selection does not touch into the scratch buffer.
   size_t keep_unselected(const StorageSelection& selection);
   SdoAbort commit(size_t count);

@@ -35,12 +35,22 @@ struct SdoResult {
   std::string bytes;          // segmented upload
 };
 
-// A small SDO and NMT client in raw CiA-301 frames over a rig's send(frame) (which delivers one
-// frame and returns what the device transmitted) and node(); `other` collects what was not the
-// SDO response (heartbeats, EMCYs, PDOs).
+// A small SDO and NMT client in raw CiA-301 frames over a rig's `device` (a pointer to the module)
+// and `can` (the RecordingCanController it transmits on); `other` collects what was not the SDO
+// response (heartbeats, EMCYs, PDOs).
 template <class Rig>
 struct CanopenClient {
   std::vector<can::CanFrame> other;
+
+  uint8_t node() { return self().device->node_id(); }
+
+  // Delivers a frame and runs one process call (no time passes); what the device sent.
+  std::vector<can::CanFrame> send(const can::CanFrame& frame) {
+    self().can.take();
+    EXPECT_TRUE(self().device->receive(frame));
+    self().device->process(0);
+    return self().can.take();
+  }
 
   // One SDO request; expects exactly one response on 0x580 + node (other frames go to `other`).
   can::CanFrame sdo(std::initializer_list<uint8_t> bytes) {
@@ -134,15 +144,6 @@ struct Tmcm3216Rig : CanopenClient<Tmcm3216Rig> {
     device->power_up();
   }
 
-  uint8_t node() const { return device->node_id(); }
-
-  // Delivers a frame and runs one process call (no time passes).
-  std::vector<can::CanFrame> send(const can::CanFrame& frame) {
-    can.take();
-    EXPECT_TRUE(device->receive(frame));
-    device->process(0);
-    return can.take();
-  }
 };
 
 }  // namespace motwin::testing

@@ -51,16 +51,6 @@ struct Tmcm1636CanopenRig : CanopenClient<Tmcm1636CanopenRig> {
     device->power_up();
   }
 
-  uint8_t node() const { return device->node_id(); }
-
-  // Delivers a frame and runs one process call (no time passes); what the node sent.
-  std::vector<can::CanFrame> send(const can::CanFrame& frame) {
-    can.take();
-    EXPECT_TRUE(device->receive(frame));
-    device->process(0);
-    return can.take();
-  }
-
   // Control ticks; what the node sent meanwhile is appended to `sent`.
   std::vector<can::CanFrame> sent;
   void tick() {

@@ -19,7 +19,7 @@
 #include "board/non_volatile_memory.h"
 #include "core/canopen/node.h"
 #include "core/canopen/object_dictionary.h"
-#include "core/cia402/switch_parameters.h"
+#include "core/cia402/trinamic_conventions.h"
 #include "core/modules/tmcm1636/tmcm1636_axis.h"
 #include "core/modules/tmcm1636/tmcm1636_canopen_drive.h"
 #include "core/modules/tmcm1636/tmcm1636_hardware.h"
@@ -100,7 +100,7 @@ inline constexpr AxisParameterObject kAxisParameterObjects[] = {
 
 // The objects of the module that are neither the axis' settings nor the drive's.
 struct Tmcm1636CanopenObjects {
-  // 2005 (cia402/switch_parameters.h; the EDS's default 3: neither limit switch used).
+  // 2005 (cia402/trinamic_conventions.h; the EDS's default 3: neither limit switch used).
   uint32_t switch_parameters = cia402::switch_parameter::kLeftDisabled | cia402::switch_parameter::kRightDisabled;
   uint32_t outputs = 0;        // 2703 sub 1 as written: bit n for GPO n
   uint32_t output_mask = 0;    // 2703 sub 2: which outputs a write of sub 1 switches

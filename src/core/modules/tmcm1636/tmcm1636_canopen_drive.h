@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "core/cia402/axis_drive.h"
+#include "core/cia402/trinamic_conventions.h"
 #include "core/motion/eight_point_ramp.h"
 
 namespace motwin::modules::tmcm1636 {
@@ -25,10 +26,6 @@ inline constexpr uint16_t kCanopenEmcyGeneric = 0x1000;
 inline constexpr uint16_t kCanopenEmcyUndervoltage = 0xFF00;
 inline constexpr uint16_t kCanopenEmcyOvervoltage = 0x3210;
 inline constexpr uint16_t kCanopenEmcyOvertemperature = 0x4310;
-
-// Statusword bits 14 and 15, manufacturer-specific in CiA-402.
-inline constexpr uint16_t kCanopenSwMotorActivity = 1u << 14;  // the motor moves
-inline constexpr uint16_t kCanopenSwDirection = 1u << 15;      // direction of the last motion: 1 = negative
 
 struct Tmcm1636DriveObjects {
   // 2058 (the module sets it with the axis' setting): the drive's velocities are in 2058 units per
@@ -60,9 +57,9 @@ struct Tmcm1636DriveObjects {
     }
     return {};
   }
+  // Bits 14 and 15 as every Trinamic drive's.
   static constexpr uint16_t manufacturer_status_bits(bool motor_active, bool negative_direction) {
-    return static_cast<uint16_t>((motor_active ? kCanopenSwMotorActivity : 0u) |
-                                 (negative_direction ? kCanopenSwDirection : 0u));
+    return cia402::trinamic_status_bits(motor_active, negative_direction);
   }
 
   // 6502 = 0x3A5.

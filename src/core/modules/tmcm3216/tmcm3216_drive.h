@@ -10,6 +10,7 @@
 
 #include "board/stepper_drive.h"
 #include "core/cia402/axis_drive.h"
+#include "core/cia402/trinamic_conventions.h"
 #include "core/modules/tmcm3216/tmcm3216_emergencies.h"
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
 #include "core/motion/eight_point_ramp.h"
@@ -24,8 +25,8 @@ inline constexpr uint8_t kAccelerationDimensionInternal = 0;
 inline constexpr uint8_t kAccelerationDimensionPps2 = 179;
 
 // Statusword bits 14 and 15, manufacturer-specific in CiA-402 (manual 6.1.2).
-inline constexpr uint16_t kSwMotorActivity = 1u << 14;  // the motor moves
-inline constexpr uint16_t kSwDirection = 1u << 15;      // direction of the last motion: 1 = negative
+using cia402::kSwDirection;
+using cia402::kSwMotorActivity;
 
 // The 2102 flags with which the driver cannot run the motor (table 365: the driver is switched
 // off): the drive's power-stage fault (cia402::AxisInputs::power_stage_fault).
@@ -90,7 +91,7 @@ struct Tmcm3216DriveObjects {
   static constexpr bool kServo = false;
 
   static constexpr uint16_t manufacturer_status_bits(bool motor_active, bool negative_direction) {
-    return static_cast<uint16_t>((motor_active ? kSwMotorActivity : 0u) | (negative_direction ? kSwDirection : 0u));
+    return cia402::trinamic_status_bits(motor_active, negative_direction);
   }
 };
 

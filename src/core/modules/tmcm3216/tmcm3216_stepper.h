@@ -19,7 +19,7 @@
 #include <cstdint>
 
 #include "board/stepper_drive.h"
-#include "core/cia402/switch_parameters.h"
+#include "core/cia402/trinamic_conventions.h"
 #include "core/motion/coolstep.h"
 #include "core/motion/stall_detector.h"
 
