@@ -15,6 +15,7 @@ import motwin_harness as mh
 
 try:  # without Selenium, HeadlessChromium skips the test before any of these is used
     from selenium.webdriver.common.by import By
+    from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 except ImportError:  # pragma: no cover - reported as a skip
     pass
@@ -110,6 +111,31 @@ class ConsolePage(HeadlessChromium):
     def screenshot(self, motwin, name):
         path = os.path.join(artefact_dir(motwin, self.ARTEFACTS), name + ".png")
         mh.check(self.driver.save_screenshot(path), f"screenshot {path}")
+
+    # The Parameters view and the direct-mode console, what every module's page has.
+    def value_of(self, key):
+        elements = self.finds(f'input[data-key="{key}"]')
+        return elements[0].get_attribute("value") if elements else None
+
+    def reply_of(self, key):
+        elements = self.finds(f'tr[data-key="{key}"] td.reply')
+        return elements[0].text if elements else ""
+
+    def set_filter(self, text):
+        field = self.find("#filter")
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(Keys.BACKSPACE)  # an input event, which clear() does not send
+        if text:
+            field.send_keys(text)
+
+    def console_lines(self):
+        return [item.text for item in self.finds("#console-log li")]
+
+    def type_command(self, text):
+        field = self.find("#console-input")
+        field.send_keys(text)
+        field.send_keys(Keys.ENTER)
 
     def check_log_clean(self):
         severe = self.severe_log_entries()

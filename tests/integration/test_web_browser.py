@@ -34,32 +34,7 @@ SCOPE_CURVES = {"a50": "AP50", "a52": "AP52", "a42": "AP42", "a31": "AP31"}
 SCOPE_TARGET = 40000  # counts: with the default ramp (AP 45 = 1) a motion of about 0.7 s simulated
 
 
-class Browser(bh.ConsolePage):
-    """The console's page in headless Chromium, with helpers for its views."""
-
-    def value_of(self, key):
-        elements = self.finds(f'input[data-key="{key}"]')
-        return elements[0].get_attribute("value") if elements else None
-
-    def reply_of(self, key):
-        elements = self.finds(f'tr[data-key="{key}"] td.reply')
-        return elements[0].text if elements else ""
-
-    def set_filter(self, text):
-        field = self.find("#filter")
-        field.click()
-        field.send_keys(Keys.CONTROL, "a")
-        field.send_keys(Keys.BACKSPACE)  # an input event, which clear() does not send
-        if text:
-            field.send_keys(text)
-
-    def console_lines(self):
-        return [item.text for item in self.finds("#console-log li")]
-
-    def type_command(self, text):
-        field = self.find("#console-input")
-        field.send_keys(text)
-        field.send_keys(Keys.ENTER)
+Browser = bh.ConsolePage  # the console's page in headless Chromium, with helpers for its views
 
 
 def test_parameters_and_console(motwin):

@@ -317,34 +317,13 @@ def test_node_beside_a_tmcm3216(motwin):
 # --- In the browser -------------------------------------------------------------------------------
 
 class Browser(bh.ConsolePage):
-    def value_of(self, key):
-        elements = self.finds(f'input[data-key="{key}"]')
-        return elements[0].get_attribute("value") if elements else None
-
-    def reply_of(self, key):
-        elements = self.finds(f'tr[data-key="{key}"] td.reply')
-        return elements[0].text if elements else ""
-
-    def set_filter(self, text):
-        field = self.find("#filter")
-        field.click()
-        field.send_keys(Keys.CONTROL, "a")
-        field.send_keys(Keys.BACKSPACE)  # an input event, which clear() does not send
-        field.send_keys(text)
+    """The console's page, with the CANopen and World views' helpers."""
 
     def edit(self, key, text):
         field = self.find(f'input[data-key="{key}"]')
         field.click()
         field.send_keys(Keys.CONTROL, "a")
         field.send_keys(text, Keys.ENTER)
-
-    def type_command(self, text):
-        field = self.find("#console-input")
-        field.send_keys(text)
-        field.send_keys(Keys.ENTER)
-
-    def console_lines(self):
-        return [item.text for item in self.finds("#console-log li")]
 
     def axis_cell(self, name):
         cells = self.finds(f'#canopen-axes tr[data-axis="0"] td.{name}')
