@@ -4,6 +4,8 @@
 // dictionary().
 #pragma once
 
+#include <fuzzer/FuzzedDataProvider.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -716,6 +718,48 @@ FUZZ_UNTRACED void check_dictionary_ranges(Device& device) {
   }
 }
 
+
+// An expedited SDO download of `value` to index/sub with the size of its type (4 bytes for an
+// object the table lacks or a string), as a master sends it.
+template <class Device>
+can::CanFrame expedited_download(Device& device, uint16_t index, uint8_t sub, int64_t value) {
+  canopen::ObjectRef ref;
+  uint8_t size = 4;
+  if (ObjectLookup::of(device).find(index, sub, ref) && canopen::is_numeric(ref.info->type)) {
+    size = canopen::type_size(ref.info->type);
+    if (size > 4) size = 4;
+  }
+  can::CanFrame frame;
+  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
+  frame.dlc = 8;
+  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
+  frame.data[1] = static_cast<uint8_t>(index);
+  frame.data[2] = static_cast<uint8_t>(index >> 8);
+  frame.data[3] = sub;
+  const auto bits = static_cast<uint64_t>(value);
+  for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
+  return frame;
+}
+
+// A raw SDO request a client could plausibly send: any command specifier and bytes (sometimes a
+// short frame), mostly on a real object of the table, of one of `axes` axes (1: what the input
+// picks for the axis is not consumed).
+template <class Device>
+can::CanFrame raw_sdo_request(FuzzedDataProvider& in, Device& device, int axes) {
+  can::CanFrame frame;
+  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
+  frame.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8) : 8;
+  for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+  if (in.ConsumeBool()) {
+    const auto rows = device.dictionary().rows();
+    const auto& info = rows[in.ConsumeIntegralInRange<size_t>(0, rows.size() - 1)].info;
+    const uint16_t index = static_cast<uint16_t>(info.index + in.ConsumeIntegralInRange<int>(0, axes - 1) * info.axis_stride);
+    frame.data[1] = static_cast<uint8_t>(index);
+    frame.data[2] = static_cast<uint8_t>(index >> 8);
+    frame.data[3] = info.sub;
+  }
+  return frame;
+}
 
 // MOTWIN_FUZZ_TRACE=1 prints every frame in and out: for reading a saved crash input.
 inline void trace(const char* direction, const can::CanFrame& frame) {

@@ -30,24 +30,6 @@ using namespace motwin;
 using fuzz::check_dictionary_ranges;
 using fuzz::trace;
 
-// A request a client could plausibly send: mostly well-formed command specifiers on real
-// objects, sometimes anything.
-can::CanFrame next_sdo_request(FuzzedDataProvider& in, fuzz::Tmcm3216& device) {
-  can::CanFrame frame;
-  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
-  frame.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8) : 8;
-  for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
-  if (in.ConsumeBool()) {
-    const auto rows = device.dictionary().rows();
-    const auto& info = rows[in.ConsumeIntegralInRange<size_t>(0, rows.size() - 1)].info;
-    const uint16_t index = static_cast<uint16_t>(info.index + in.ConsumeIntegralInRange<int>(0, 2) * info.axis_stride);
-    frame.data[1] = static_cast<uint8_t>(index);
-    frame.data[2] = static_cast<uint8_t>(index >> 8);
-    frame.data[3] = info.sub;
-  }
-  return frame;
-}
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -80,7 +62,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         elapsed_us = in.ConsumeIntegralInRange<uint32_t>(0, 2'000'000);
         break;
       default:
-        frame = next_sdo_request(in, device);
+        frame = fuzz::raw_sdo_request(in, device, 3);
         break;
     }
     const bool time_only = elapsed_us != 0 || (frame.id == 0 && frame.dlc == 0);

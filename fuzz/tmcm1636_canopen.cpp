@@ -156,26 +156,6 @@ struct CanopenRig {
   }
 };
 
-// An expedited SDO download of `value` to index/sub with the size of its type (or 4 bytes).
-can::CanFrame sdo_download(Device& device, uint16_t index, uint8_t sub, int64_t value) {
-  canopen::ObjectRef ref;
-  uint8_t size = 4;
-  if (fuzz::ObjectLookup::of(device).find(index, sub, ref) && canopen::is_numeric(ref.info->type)) {
-    size = canopen::type_size(ref.info->type);
-    if (size > 4 || size == 0) size = 4;
-  }
-  can::CanFrame frame;
-  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
-  frame.dlc = 8;
-  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
-  frame.data[1] = static_cast<uint8_t>(index);
-  frame.data[2] = static_cast<uint8_t>(index >> 8);
-  frame.data[3] = sub;
-  const auto bits = static_cast<uint64_t>(value);
-  for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
-  return frame;
-}
-
 // A numeric object as an upload gives it (0 if it has none), through the checks' untraced lookup.
 uint32_t read_u32(Device& device, uint16_t index, uint8_t sub) {
   canopen::ObjectRef ref;
@@ -295,7 +275,7 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
     start.data[0] = 0x01;
     prelude.push_back(start);
   }
-  if ((bring_up & 0x0F) < std::size(kModes)) prelude.push_back(sdo_download(device, 0x6060, 0, kModes[bring_up & 0x0F]));
+  if ((bring_up & 0x0F) < std::size(kModes)) prelude.push_back(fuzz::expedited_download(device, 0x6060, 0, kModes[bring_up & 0x0F]));
   if (bring_up & 0x10) {
     struct Setting {
       uint16_t index;
@@ -304,10 +284,10 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
     };
     constexpr Setting kProfile[] = {{0x6081, 0, 1000}, {0x6083, 0, 5000}, {0x6084, 0, 5000}, {0x6085, 0, 5000},
                                     {0x609A, 0, 5000}, {0x6099, 1, 300},  {0x6099, 2, 60}};
-    for (const Setting& s : kProfile) prelude.push_back(sdo_download(device, s.index, s.sub, s.value));
+    for (const Setting& s : kProfile) prelude.push_back(fuzz::expedited_download(device, s.index, s.sub, s.value));
   }
   if (bring_up & 0x20) {
-    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) prelude.push_back(sdo_download(device, 0x6040, 0, cw));
+    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) prelude.push_back(fuzz::expedited_download(device, 0x6040, 0, cw));
   }
   for (const can::CanFrame& frame : prelude) {
     trace("->", frame);
@@ -346,7 +326,7 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
         } else {
           value = in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(-200'000, 200'000) : in.ConsumeIntegral<int32_t>();
         }
-        frame = sdo_download(device, object.index, sub, value);
+        frame = fuzz::expedited_download(device, object.index, sub, value);
         break;
       }
       case 4: {  // any object of the table, at its range edges or any value (downloads), or an upload
@@ -354,23 +334,13 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
         const auto& info = rows[in.ConsumeIntegralInRange<size_t>(0, rows.size() - 1)].info;
         const int64_t value = in.PickValueInArray({info.min, info.max, info.default_value, info.max + 1, info.min - 1,
                                                    static_cast<int64_t>(in.ConsumeIntegral<int32_t>())});
-        frame = sdo_download(device, info.index, info.sub, value);
+        frame = fuzz::expedited_download(device, info.index, info.sub, value);
         if (in.ConsumeBool()) frame.data[0] = 0x40;  // initiate upload
         break;
       }
-      case 5: {  // a raw SDO request: any command specifier and bytes, mostly on a real object
-        frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
-        frame.dlc = in.ConsumeIntegralInRange<int>(0, 15) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8) : 8;
-        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
-        if (in.ConsumeBool()) {
-          const auto rows = device.dictionary().rows();
-          const auto& info = rows[in.ConsumeIntegralInRange<size_t>(0, rows.size() - 1)].info;
-          frame.data[1] = static_cast<uint8_t>(info.index);
-          frame.data[2] = static_cast<uint8_t>(info.index >> 8);
-          frame.data[3] = info.sub;
-        }
+      case 5:  // a raw SDO request: any command specifier and bytes, mostly on a real object
+        frame = fuzz::raw_sdo_request(in, device, 1);
         break;
-      }
       case 6: {  // an RPDO on its default COB-ID (6040; 6040 + 6060; 6040 + 607A; 6040 + 60FF)
         frame.id = in.PickValueInArray({0x200u, 0x300u, 0x400u, 0x500u}) + device.node_id();
         frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8)

@@ -82,26 +82,6 @@ void check_statuswords(Tmcm3216& device) {
   }
 }
 
-// An expedited SDO download of `value` to index/sub with the size of its type (or 4 bytes).
-can::CanFrame sdo_download(Tmcm3216& device, uint16_t index, uint8_t sub, int64_t value) {
-  canopen::ObjectRef ref;
-  uint8_t size = 4;
-  if (device.dictionary().find(index, sub, ref) == canopen::SdoAbort::kNone && canopen::is_numeric(ref.info->type)) {
-    size = canopen::type_size(ref.info->type);
-    if (size > 4) size = 4;
-  }
-  can::CanFrame frame;
-  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
-  frame.dlc = 8;
-  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
-  frame.data[1] = static_cast<uint8_t>(index);
-  frame.data[2] = static_cast<uint8_t>(index >> 8);
-  frame.data[3] = sub;
-  const auto bits = static_cast<uint64_t>(value);
-  for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
-  return frame;
-}
-
 // Up to `ticks` motion ticks of module and board within the input's budget, with the
 // motor-standstill invariant checked around each: an axis whose PDS state has the drive
 // function disabled before and after a tick does not move its motor. The loop and the checks are
@@ -179,9 +159,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (uint8_t axis = 0; axis < kAxes; ++axis) {
     if ((bring_up >> axis & 1) == 0) continue;
     const auto offset = static_cast<uint16_t>(axis * 0x800);
-    if (bring_up & 0x80) prelude.push_back(sdo_download(*device, static_cast<uint16_t>(0x2005 + axis * 0x200), 0, 3));
-    prelude.push_back(sdo_download(*device, 0x6060 + offset, 0, kModes[(bring_up >> 3) & 7]));
-    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) prelude.push_back(sdo_download(*device, 0x6040 + offset, 0, cw));
+    if (bring_up & 0x80) prelude.push_back(fuzz::expedited_download(*device, static_cast<uint16_t>(0x2005 + axis * 0x200), 0, 3));
+    prelude.push_back(fuzz::expedited_download(*device, 0x6060 + offset, 0, kModes[(bring_up >> 3) & 7]));
+    for (uint16_t cw : {0x0006, 0x0007, 0x000F}) prelude.push_back(fuzz::expedited_download(*device, 0x6040 + offset, 0, cw));
   }
   for (const can::CanFrame& frame : prelude) {
     device->receive(frame);
@@ -216,7 +196,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         } else {
           value = in.ConsumeBool() ? in.ConsumeIntegralInRange<int64_t>(-200'000, 200'000) : in.ConsumeIntegral<int32_t>();
         }
-        frame = sdo_download(*device, static_cast<uint16_t>(base + axis * 0x800), sub, value);
+        frame = fuzz::expedited_download(*device, static_cast<uint16_t>(base + axis * 0x800), sub, value);
         break;
       }
       case 4: {  // any object of the dictionary, any value (downloads) or an upload
@@ -225,7 +205,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const auto index = static_cast<uint16_t>(info.index + in.ConsumeIntegralInRange<int>(0, kAxes - 1) * info.axis_stride);
         const int64_t value = in.PickValueInArray({info.min, info.max, info.default_value, info.max + 1, info.min - 1,
                                                    static_cast<int64_t>(in.ConsumeIntegral<int32_t>())});
-        frame = sdo_download(*device, index, info.sub, value);
+        frame = fuzz::expedited_download(*device, index, info.sub, value);
         if (in.ConsumeBool()) frame.data[0] = 0x40;  // initiate upload
         break;
       }
