@@ -719,6 +719,20 @@ FUZZ_UNTRACED void check_dictionary_ranges(Device& device) {
 }
 
 
+// An expedited SDO download of `size` bytes (1 to 4) to node `node_id`; the bytes of `value` past
+// `size` go out too (CiA-301 leaves them undefined: the server must ignore them).
+inline can::CanFrame expedited_download(uint8_t node_id, uint16_t index, uint8_t sub, uint32_t value, uint8_t size) {
+  can::CanFrame frame;
+  frame.id = canopen::kSdoRequestCobIdBase + node_id;
+  frame.dlc = 8;
+  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
+  frame.data[1] = static_cast<uint8_t>(index);
+  frame.data[2] = static_cast<uint8_t>(index >> 8);
+  frame.data[3] = sub;
+  for (int i = 0; i < 4; ++i) frame.data[4 + i] = static_cast<uint8_t>(value >> (8 * i));
+  return frame;
+}
+
 // An expedited SDO download of `value` to index/sub with the size of its type (4 bytes for an
 // object the table lacks or a string), as a master sends it.
 template <class Device>
@@ -729,16 +743,8 @@ can::CanFrame expedited_download(Device& device, uint16_t index, uint8_t sub, in
     size = canopen::type_size(ref.info->type);
     if (size > 4) size = 4;
   }
-  can::CanFrame frame;
-  frame.id = canopen::kSdoRequestCobIdBase + device.node_id();
-  frame.dlc = 8;
-  frame.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
-  frame.data[1] = static_cast<uint8_t>(index);
-  frame.data[2] = static_cast<uint8_t>(index >> 8);
-  frame.data[3] = sub;
-  const auto bits = static_cast<uint64_t>(value);
-  for (int i = 0; i < 4; ++i) frame.data[4 + i] = i < size ? static_cast<uint8_t>(bits >> (8 * i)) : 0;
-  return frame;
+  const uint32_t bits = static_cast<uint32_t>(value) & (size == 4 ? 0xFFFF'FFFFu : (1u << (8 * size)) - 1);
+  return expedited_download(device.node_id(), index, sub, bits, size);
 }
 
 // A raw SDO request a client could plausibly send: any command specifier and bytes (sometimes a
@@ -758,6 +764,18 @@ can::CanFrame raw_sdo_request(FuzzedDataProvider& in, Device& device, int axes) 
     frame.data[2] = static_cast<uint8_t>(index >> 8);
     frame.data[3] = info.sub;
   }
+  return frame;
+}
+
+// An NMT command to a drive under test: mostly start (so that PDOs flow), sometimes stop,
+// pre-operational, reset communication or (rarely) reset node, to this node or to all.
+inline can::CanFrame drive_nmt_command(FuzzedDataProvider& in, uint8_t node_id) {
+  can::CanFrame frame;
+  frame.id = 0;
+  frame.dlc = 2;
+  const uint8_t commands[] = {0x01, 0x01, 0x01, 0x80, 0x02, 0x82, 0x81};
+  frame.data[0] = commands[in.ConsumeIntegralInRange<int>(0, 6)];
+  frame.data[1] = in.ConsumeBool() ? 0 : node_id;
   return frame;
 }
 

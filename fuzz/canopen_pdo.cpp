@@ -74,14 +74,7 @@ class PdoFuzzer {
 
   // An expedited SDO download through the bus, as a master does it; returns the abort code.
   uint32_t sdo_write(uint16_t index, uint8_t sub, uint32_t value, uint8_t size) {
-    can::CanFrame request;
-    request.id = canopen::kSdoRequestCobIdBase + device_.node_id();
-    request.dlc = 8;
-    request.data[0] = static_cast<uint8_t>(0x23 | ((4 - size) << 2));
-    request.data[1] = static_cast<uint8_t>(index);
-    request.data[2] = static_cast<uint8_t>(index >> 8);
-    request.data[3] = sub;
-    for (int i = 0; i < 4; ++i) request.data[4 + i] = static_cast<uint8_t>(value >> (8 * i));
+    const can::CanFrame request = fuzz::expedited_download(device_.node_id(), index, sub, value, size);
     uint32_t abort = 0;
     deliver(request, [&](const can::CanFrame& response) {
       if (response.data[0] == 0x80) abort = fuzz::le32(&response.data[4]);

@@ -174,14 +174,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     bool send = true;
     client.before(nullptr, 0);
     switch (in.ConsumeIntegralInRange<int>(0, 11)) {
-      case 0: {  // NMT: mostly start, sometimes the others (reset node rarely)
-        frame.id = 0;
-        frame.dlc = 2;
-        const uint8_t commands[] = {0x01, 0x01, 0x01, 0x80, 0x02, 0x82, 0x81};
-        frame.data[0] = commands[in.ConsumeIntegralInRange<int>(0, 6)];
-        frame.data[1] = in.ConsumeBool() ? 0 : device->node_id();
+      case 0:
+        frame = fuzz::drive_nmt_command(in, device->node_id());
         break;
-      }
       case 1:
       case 2:
       case 3: {  // a drive object of some axis
