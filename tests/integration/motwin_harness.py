@@ -227,14 +227,7 @@ class ClientBase:
 
     def wait_for(self, description, predicate, timeout, interval=0.005):
         """Polls predicate() (which talks to the module) until true; returns its last value."""
-        deadline = time.monotonic() + timeout
-        while True:
-            result = predicate()
-            if result:
-                return result
-            if time.monotonic() > deadline:
-                raise TestFailure(f"timed out after {timeout} s waiting for {description}")
-            time.sleep(interval)
+        return poll_until(description, predicate, timeout, interval)
 
     def __enter__(self):
         return self
@@ -325,6 +318,19 @@ def bytes_received_at(port):
         m = re.search(r"\bbytes_received:(\d+)", info)
         received.append((int(m.group(1)) if m else 0) - int(head.split()[0]))
     return received
+
+
+def poll_until(description, predicate, timeout, interval=0.005):
+    """Polls predicate() (which talks to the module) until true and returns its value; `timeout`
+    (wall seconds) only bounds a module that stopped answering or a simulation that stood still."""
+    deadline = time.monotonic() + timeout
+    while True:
+        result = predicate()
+        if result:
+            return result
+        if time.monotonic() > deadline:
+            raise TestFailure(f"timed out after {timeout} s waiting for {description}")
+        time.sleep(interval)
 
 
 def wait_until_read_by_peer(sock, timeout=60.0):

@@ -16,11 +16,6 @@ import web_harness as wh  # noqa: E402
 MAX_CURRENT = 11  # TMCM-1636 axis parameter: 0..60000 mA, RWEX
 
 
-def require_websocket():
-    if wh.websocket is None:
-        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
-
-
 def test_http_files_and_loopback(motwin):
     with TempDir() as state, wh.WebServer(motwin, state).start() as server:
         # Bound to 127.0.0.1 only (7F000001 in /proc/net/tcp's byte order).
@@ -40,7 +35,7 @@ def test_http_files_and_loopback(motwin):
 
 
 def test_parameters_through_the_modules_checks(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, wh.WebServer(motwin, state).start() as server, \
             TcpClient(server.tcp_port) as tmcl, server.console() as console:
         listing = console.ask("list")
@@ -77,7 +72,7 @@ def test_parameters_through_the_modules_checks(motwin):
 
 
 def test_subscription_updates(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, wh.WebServer(motwin, state).start() as server, \
             TcpClient(server.tcp_port) as tmcl, server.console() as console:
         reply = console.ask("subscribe", rate_hz=25, items=[{"module": 0, "kind": "axis", "number": MAX_CURRENT},
@@ -103,7 +98,7 @@ def test_subscription_updates(motwin):
 
 
 def test_garbage_leaves_connection_and_module_intact(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, wh.WebServer(motwin, state).start() as server, \
             TcpClient(server.tcp_port) as tmcl, server.console() as console:
         for garbage in ("{not json", "[1, 2, 3]", "\u00ff\u0000", "{\"id\": 5}", "{\"id\": 6, \"op\": 7}"):
@@ -121,7 +116,7 @@ def test_garbage_leaves_connection_and_module_intact(motwin):
 
 
 def test_token_and_non_loopback(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state:
         refused = mh.Server(motwin, state, extra_args=["--web", "0.0.0.0:0"])
         check_equal(refused.start_expect_failure(), 2, "--web 0.0.0.0 without a token")
@@ -140,7 +135,7 @@ def test_token_and_non_loopback(motwin):
 
 
 def test_canopen_node(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, wh.WebCanServer(motwin, state).start() as server, server.console() as console:
         module = console.ask("list")["modules"][0]
         check_equal((module["protocol"], module["node_id"]), ("canopen", 1), "the listed node")

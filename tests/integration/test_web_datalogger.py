@@ -33,11 +33,6 @@ STEP_RPM = 2000
 TRIGGER_RPM = 50
 
 
-def require_websocket():
-    if wh.websocket is None:
-        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
-
-
 def wait_for_state(console, state):
     """Polls the capture's state over the console until it is `state` (the simulation runs on)."""
     for _ in range(100000):
@@ -58,7 +53,7 @@ class Tmcm142WebServer(wh.WebServer):
 def test_datalogger_over_websocket(motwin):
     """A capture through the op equals what GET_SAMPLE answers over TMCL/TCP; the trigger and
     pretrigger land where the module puts them; a TMCM-142 refuses with its own status."""
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, wh.WebServer(motwin, state).start() as server, TcpClient(server.tcp_port) as tmcl, \
             server.console() as console:
         info = console.ask("datalogger", action="info")

@@ -46,11 +46,6 @@ class Web142Server(wh.WebServer):
         super().__init__(motwin, state_dir, module="tmcm-142", **options)
 
 
-def require_websocket():
-    if wh.websocket is None:
-        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
-
-
 def tcp_status(tmcl):
     """(mode, program counter, accumulator) by command 135 over TMCL/TCP."""
     status = mh.expect_reply(tmcl.request(APPLICATION_STATUS, 1), APPLICATION_STATUS, what="135 type 1").value
@@ -59,13 +54,7 @@ def tcp_status(tmcl):
 
 
 def wait_for(description, condition):
-    deadline = time.monotonic() + bh.WAIT_S
-    while True:
-        value = condition()
-        if value:
-            return value
-        check(time.monotonic() < deadline, f"waited {bh.WAIT_S} s for {description}")
-        time.sleep(0.01)
+    return mh.poll_until(description, condition, bh.WAIT_S, interval=0.01)
 
 
 def check_program_ops(server):
@@ -109,7 +98,7 @@ def check_program_ops(server):
 
 
 def test_program_ops_over_websocket(motwin):
-    require_websocket()
+    wh.require_websocket()
     for server_class in (wh.WebServer, Web142Server):
         with TempDir() as state, server_class(motwin, state).start() as server:
             check_program_ops(server)
@@ -120,7 +109,7 @@ def test_tmcl_over_can_node(motwin):
     """A TMCM-1636 that is only a node of the bus (`--node tmcm-1636` beside a TMCM-3216) is reached
     by TMCL over CAN: parameters, a direct-mode instruction, the program ops, an ID change; checked
     by a TMCL-over-CAN host on socketcand (python3-can)."""
-    require_websocket()
+    wh.require_websocket()
     try:
         import can  # noqa: F401 - Debian's python3-can
     except ImportError:

@@ -17,7 +17,6 @@ import os
 import re
 import struct
 import sys
-import time
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -66,22 +65,9 @@ class CanopenBusServer(wh.WebBusServer):
     BANNER = r"motwin: node tmcm-1636-1 tmcm-1636 \(CANopen V1\.12\) eeprom (.+)"
 
 
-def require_websocket():
-    if wh.websocket is None:
-        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
-
-
 def wait_until(description, condition):
-    """Polls `condition` (each poll a request to the serve) until it holds; the bound only catches
-    a serve that stopped answering or a simulation that stood still."""
-    deadline = time.monotonic() + CONDITION_TIMEOUT
-    while True:
-        result = condition()
-        if result:
-            return result
-        if time.monotonic() > deadline:
-            raise mh.TestFailure(f"waited {CONDITION_TIMEOUT} s for {description}")
-        time.sleep(0.01)
+    """Polls `condition` (each poll a request to the serve) until it holds."""
+    return mh.poll_until(description, condition, CONDITION_TIMEOUT, interval=0.01)
 
 
 def eds_entries():
@@ -169,7 +155,7 @@ def check_objects_like_the_eds(module, what):
 
 
 def test_single_module_over_websocket(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, CanopenWebServer(motwin, state).start() as server, server.console() as console:
         listing = console.ask("list")["modules"]
         check_equal(len(listing), 1, "one module")
@@ -263,7 +249,7 @@ def test_single_module_over_websocket(motwin):
 
 def test_shaft_follows_the_motor(motwin):
     """A physical motor: the world's shaft turns as 6064 counts in a profile position move."""
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, CanopenWebServer(motwin, state, REFERENCE_MOTOR).start() as server, \
             server.console() as console:
         axis = console.ask("world", values_only=True)["axes"][0]
@@ -284,7 +270,7 @@ def test_shaft_follows_the_motor(motwin):
 
 
 def test_node_beside_a_tmcm3216(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, CanopenBusServer(motwin, state).start() as server, server.console() as console:
         modules = console.ask("list")["modules"]
         check_equal([(m["product"], m["firmware"], m["protocol"], m["node_id"]) for m in modules],

@@ -45,11 +45,6 @@ class WorldBusServer(wh.WebBusServer):
     BANNER = r"motwin: node tmcm-142-1 tmcm-142 \(142V1\.06\) eeprom (.+)"
 
 
-def require_websocket():
-    if wh.websocket is None:
-        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
-
-
 def wait_for(description, condition, tmcl):
     """Polls `condition` while the module's simulated clock runs (no wall-clock assertion)."""
     for _ in range(2000):
@@ -60,7 +55,7 @@ def wait_for(description, condition, tmcl):
 
 
 def test_world_ops_over_websocket(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, WorldServer(motwin, state).start() as server, \
             TcpClient(server.tcp_port) as tmcl, server.console() as console:
         world = console.ask("world")
@@ -106,7 +101,7 @@ def test_world_ops_over_websocket(motwin):
 
 
 def test_world_of_a_bus_is_read_only(motwin):
-    require_websocket()
+    wh.require_websocket()
     with TempDir() as state, WorldBusServer(motwin, state).start() as server, server.console() as console:
         for module, axes in ((0, 1), (1, 3)):
             world = console.ask("world", module=module)

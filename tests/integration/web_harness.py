@@ -18,6 +18,12 @@ except ImportError:  # pragma: no cover - the harness reports it
 REPLY_TIMEOUT = 30.0
 
 
+def require_websocket():
+    """Skips the test when Debian's python3-websocket is missing."""
+    if websocket is None:
+        raise mh.Skipped("python3-websocket is not installed (scripts/install-deps.sh installs it)")
+
+
 class WebServer(mh.Server):
     """`motwin serve` of a TMCM-1636 with TMCL over TCP and the web console, both on free ports."""
 
