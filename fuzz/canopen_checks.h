@@ -779,6 +779,32 @@ inline can::CanFrame drive_nmt_command(FuzzedDataProvider& in, uint8_t node_id) 
   return frame;
 }
 
+// A frame on one of axis 0's four default RPDOs (6040; 6040+6060; 6040+607A; 6040+60FF): mostly
+// 2, 3 or 6 bytes, a controlword of `controlwords` and, on RPDO 2, a mode of `modes`.
+template <size_t kControlwordCount, size_t kModeCount>
+can::CanFrame drive_rpdo_frame(FuzzedDataProvider& in, uint8_t node_id, const uint16_t (&controlwords)[kControlwordCount],
+                               const int8_t (&modes)[kModeCount]) {
+  can::CanFrame frame;
+  frame.id = in.PickValueInArray({0x200u, 0x300u, 0x400u, 0x500u}) + node_id;
+  frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8)
+                                                         : in.PickValueInArray({2, 3, 6});
+  for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+  const uint16_t cw = controlwords[in.ConsumeIntegralInRange<size_t>(0, kControlwordCount - 1)];
+  frame.data[0] = static_cast<uint8_t>(cw);
+  frame.data[1] = static_cast<uint8_t>(cw >> 8);
+  if (frame.id == 0x300u + node_id) frame.data[2] = static_cast<uint8_t>(modes[frame.data[2] % kModeCount]);
+  return frame;
+}
+
+// SYNC, sometimes with a counter byte.
+inline can::CanFrame sync_frame(FuzzedDataProvider& in) {
+  can::CanFrame frame;
+  frame.id = 0x80;
+  frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0;
+  frame.data[0] = in.ConsumeIntegral<uint8_t>();
+  return frame;
+}
+
 // MOTWIN_FUZZ_TRACE=1 prints every frame in and out: for reading a saved crash input.
 inline void trace(const char* direction, const can::CanFrame& frame) {
   static const bool enabled = std::getenv("MOTWIN_FUZZ_TRACE") != nullptr;

@@ -336,23 +336,11 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
       case 5:  // a raw SDO request: any command specifier and bytes, mostly on a real object
         frame = fuzz::raw_sdo_request(in, device, 1);
         break;
-      case 6: {  // an RPDO on its default COB-ID (6040; 6040 + 6060; 6040 + 607A; 6040 + 60FF)
-        frame.id = in.PickValueInArray({0x200u, 0x300u, 0x400u, 0x500u}) + device.node_id();
-        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8)
-                                                               : in.PickValueInArray({2, 3, 6});
-        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
-        const uint16_t cw = kControlwords[in.ConsumeIntegralInRange<size_t>(0, std::size(kControlwords) - 1)];
-        frame.data[0] = static_cast<uint8_t>(cw);
-        frame.data[1] = static_cast<uint8_t>(cw >> 8);
-        if (frame.id == 0x300u + device.node_id()) {
-          frame.data[2] = static_cast<uint8_t>(kModes[frame.data[2] % std::size(kModes)]);
-        }
+      case 6:  // an RPDO on its default COB-ID (6040; 6040 + 6060; 6040 + 607A; 6040 + 60FF)
+        frame = fuzz::drive_rpdo_frame(in, device.node_id(), kControlwords, kModes);
         break;
-      }
       case 7:  // SYNC
-        frame.id = 0x80;
-        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0;
-        frame.data[0] = in.ConsumeIntegral<uint8_t>();
+        frame = fuzz::sync_frame(in);
         break;
       case 8: {  // node guarding: a remote frame on 0x700 + node ID (or a heartbeat of another node)
         const bool other = in.ConsumeIntegralInRange<int>(0, 7) == 0;

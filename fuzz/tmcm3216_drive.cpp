@@ -204,21 +204,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (in.ConsumeBool()) frame.data[0] = 0x40;  // initiate upload
         break;
       }
-      case 5: {  // an RPDO of axis 0 (defaults: 6040, 6040+6060, 6040+607A, 6040+60FF)
-        frame.id = in.PickValueInArray({0x200u, 0x300u, 0x400u, 0x500u}) + device->node_id();
-        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? in.ConsumeIntegralInRange<uint8_t>(0, 8)
-                                                               : in.PickValueInArray({2, 3, 6});
-        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
-        const uint16_t cw = kControlwords[in.ConsumeIntegralInRange<size_t>(0, std::size(kControlwords) - 1)];
-        frame.data[0] = static_cast<uint8_t>(cw);
-        frame.data[1] = static_cast<uint8_t>(cw >> 8);
-        if (frame.id == 0x300u + device->node_id()) frame.data[2] = static_cast<uint8_t>(kModes[frame.data[2] % 9]);
+      case 5:  // an RPDO of axis 0 (defaults: 6040, 6040+6060, 6040+607A, 6040+60FF)
+        frame = fuzz::drive_rpdo_frame(in, device->node_id(), kControlwords, kModes);
         break;
-      }
       case 6:  // SYNC
-        frame.id = 0x80;
-        frame.dlc = in.ConsumeIntegralInRange<int>(0, 7) == 0 ? 1 : 0;
-        frame.data[0] = in.ConsumeIntegral<uint8_t>();
+        frame = fuzz::sync_frame(in);
         break;
       case 7: {  // any identifier
         frame.id = in.ConsumeIntegralInRange<uint32_t>(0, 0x7FF);
