@@ -1,5 +1,6 @@
 #include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 
+#include "host/zeroed_allocation.h"
 #include "sim/stepper_motor_selection.h"
 
 namespace motwin::host {
@@ -13,7 +14,9 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
   return power_up_on_bus(
       options, [&motors] { return std::make_unique<sim::Tmcm3216SimBoard>(*motors); },
       [](board::NonVolatileMemory& nvm, board::CanController& controller, sim::Tmcm3216SimBoard& board,
-         const canopen::NodeConfig& config) { return std::make_unique<Device>(nvm, controller, board.board(), config); });
+         const canopen::NodeConfig& config) {
+        return make_unique_zeroed<Device>(nvm, controller, board.board(), config);
+      });
 }
 
 }  // namespace motwin::host
