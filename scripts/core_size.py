@@ -255,10 +255,14 @@ def main():
     image_map = args[args.index("--image") + 1] if "--image" in args else None
     check_archive = args[args.index("--check") + 1] if "--check" in args else None
     root = os.path.join(build, "CMakeFiles", "motwin_core.dir", "src", "core")
+    # The archive's members: an object a deleted source left behind in an incremental build
+    # directory is not part of the core.
+    archive_path = check_archive or os.path.join(build, "libmotwin_core.a")
+    members = set(run("ar", "t", archive_path).split()) if os.path.exists(archive_path) else None
     objects = []
     for directory, _, files in os.walk(root):
         for f in sorted(files):
-            if f.endswith(".o"):
+            if f.endswith(".o") and (members is None or f in members):
                 path = os.path.join(directory, f)
                 objects.append((os.path.relpath(path, root)[: -len(".o")], ObjectFile(path)))
     if not objects:
