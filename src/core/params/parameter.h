@@ -158,17 +158,27 @@ concept WireField = std::is_same_v<Value, int32_t> || std::is_same_v<Value, uint
                     (std::is_enum_v<Value> && std::is_same_v<std::underlying_type_t<Value>, int32_t>);
 
 // A binding to one plain field of a part of the owner: `Part` is a function returning that part
-// (for example the axis config struct), `Field` a pointer to the member. Writable fields store
-// the value as it comes; read-only ones (Writable = false) reject writes.
+// (for example the axis config struct), given the owner alone or the owner and the row's axis
+// (a module with several motors: the config of motor `axis`), `Field` a pointer to the member.
+// Writable fields store the value as it comes; read-only ones (Writable = false) reject writes.
+template <class Owner, auto Part>
+constexpr auto& part_at(Owner& owner, uint8_t axis) {
+  if constexpr (std::is_invocable_v<decltype(Part), Owner&, uint8_t>) {
+    return Part(owner, axis);
+  } else {
+    return Part(owner);
+  }
+}
+
 template <class Owner, auto Part, auto Field, bool Writable = true>
 constexpr Binding<Owner> field_binding() {
-  using Value = std::remove_cvref_t<decltype(Part(std::declval<Owner&>()).*Field)>;
+  using Value = std::remove_cvref_t<decltype(part_at<Owner, Part>(std::declval<Owner&>(), 0).*Field)>;
   static_assert(WireField<Value>, "a parameter field is int32_t, uint32_t or an enum over int32_t");
   Binding<Owner> binding;
-  binding.get = [](Owner& owner, uint8_t) { return static_cast<int32_t>(Part(owner).*Field); };
+  binding.get = [](Owner& owner, uint8_t axis) { return static_cast<int32_t>(part_at<Owner, Part>(owner, axis).*Field); };
   if constexpr (Writable) {
-    binding.set = [](Owner& owner, uint8_t, int32_t value) {
-      Part(owner).*Field = static_cast<Value>(value);
+    binding.set = [](Owner& owner, uint8_t axis, int32_t value) {
+      part_at<Owner, Part>(owner, axis).*Field = static_cast<Value>(value);
       return tmcl::Status::kOk;
     };
   }

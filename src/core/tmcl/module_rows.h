@@ -76,9 +76,9 @@ class ModuleRows {
   // an enum) and returns nothing or a tmcl::Status.
   template <auto Get, auto Set>
   static constexpr Binding axis_command() {
-    return {read_axis_value<Get>, [](Module& module, uint8_t, int32_t value) {
+    return {read_axis_value<Get>, [](Module& module, uint8_t motor, int32_t value) {
               using Setter = detail::SetterOf<decltype(Set)>;
-              Axis& axis = module.axis();
+              Axis& axis = module.axis(motor);
               if constexpr (std::is_void_v<typename Setter::result_type>) {
                 (axis.*Set)(static_cast<typename Setter::value_type>(value));
                 return Status::kOk;
@@ -98,16 +98,17 @@ class ModuleRows {
   template <auto ArrayField, size_t kIndex>
   static constexpr Binding element_field() {
     using Part = typename detail::MemberOf<decltype(ArrayField)>::type;
-    return {[](Module& module, uint8_t) { return (part_of<Part>(module.axis()).*ArrayField)[kIndex]; },
-            [](Module& module, uint8_t, int32_t value) {
-              (part_of<Part>(module.axis()).*ArrayField)[kIndex] = value;
+    return {[](Module& module, uint8_t motor) { return (part_of<Part>(module.axis(motor)).*ArrayField)[kIndex]; },
+            [](Module& module, uint8_t motor, int32_t value) {
+              (part_of<Part>(module.axis(motor)).*ArrayField)[kIndex] = value;
               return Status::kOk;
             }};
   }
 
  private:
-  static AxisConfig& config_of(Module& module) { return module.axis().config; }
-  static AxisState& state_of(Module& module) { return module.axis().state; }
+  // The rows' `axis` argument is the motor of SAP/GAP (the bank of a global row).
+  static AxisConfig& config_of(Module& module, uint8_t motor) { return module.axis(motor).config; }
+  static AxisState& state_of(Module& module, uint8_t motor) { return module.axis(motor).state; }
   static Globals& globals_of(Module& module) { return module.global_config(); }
 
   // The axis, its config or its state: the part a member pointer of type `Part` applies to.
@@ -124,8 +125,8 @@ class ModuleRows {
   }
 
   template <auto Get>
-  static int32_t read_axis_value(Module& module, uint8_t /*axis*/) {
-    auto& part = part_of<typename detail::MemberOf<decltype(Get)>::type>(module.axis());
+  static int32_t read_axis_value(Module& module, uint8_t motor) {
+    auto& part = part_of<typename detail::MemberOf<decltype(Get)>::type>(module.axis(motor));
     if constexpr (std::is_member_function_pointer_v<decltype(Get)>) {
       return static_cast<int32_t>((part.*Get)());
     } else {

@@ -8,6 +8,7 @@
 namespace motwin::tmcl {
 
 struct NvmLayout {
+  uint32_t motors;                   // motors with axis parameters (and coordinates)
   uint32_t axis_parameters_offset;   // motor m, parameter n: + (m * 256 + n) * 4
   uint32_t global_parameters_offset; // bank 0 parameter n: + n * 4
   uint32_t user_variables_offset;    // bank 2 variable n: + n * 4 (n < storable count)
@@ -34,6 +35,7 @@ struct NvmLayout {
 constexpr NvmLayout make_nvm_layout(uint8_t motors, size_t storable_user_variables, size_t program_capacity,
                                     size_t coordinates_per_motor = 0) {
   NvmLayout layout{};
+  layout.motors = motors;
   layout.axis_parameters_offset = 0;
   layout.global_parameters_offset = static_cast<uint32_t>(motors) * 256u * 4u;
   layout.user_variables_offset = layout.global_parameters_offset + 256u * 4u;

@@ -1,12 +1,13 @@
-// The base of the single-axis TMCL module profiles (TMCM-1636, TMCM-142): everything they share
-// beyond the parameter storage of module_storage.h, so that each module keeps only what differs
-// (its axis, its tables, its I/O and its hooks). It owns
-//   - the axis (Axis), the bank-0 settings (Globals) and the general I/O seam (Io),
+// The base of the TMCL module profiles (TMCM-1636, TMCM-142: one motor; a module with several:
+// as many as its EEPROM layout has, kNvmLayout.motors): everything they share beyond the
+// parameter storage of module_storage.h, so that each module keeps only what differs (its axes,
+// its tables, its I/O and its hooks). It owns
+//   - the axes (one Axis per motor), the bank-0 settings (Globals) and the general I/O seam (Io),
 //   - the TMCL registers (TmclRuntime), the control tick counter and the GP 132 tick timer,
 //   - the program memory with its RAM mirror, at the program slots of the EEPROM layout,
 //   - the engine: command dispatcher and interpreter (engine.h),
 // and answers the commands that are the same on these modules: ROR/ROL/MST and MVP ABS/REL
-// through the axis parameter table, SIO/GIO over the three I/O banks, the serial settings and
+// through the axis parameter table of the motor addressed (the engine has checked its number), SIO/GIO over the three I/O banks, the serial settings and
 // autostart from the bank-0 settings, the switch conditions of WAIT and the interrupts, and
 // GP 128..132 (program_status_rows(), listed in each module's bank-0 table). The helpers its
 // parameter tables are written with come from module_rows.h.
@@ -14,7 +15,7 @@
 // A CRTP base. The module passes its parts' types and its ModuleFacts (name, identity, EEPROM
 // layout, tick period, motion parameters); besides what ModuleStorage asks for (its tables),
 // `Derived` provides
-//   - void tick_axis(): one control tick of its axis, called by tick() without a virtual call;
+//   - void tick_axis(): one control tick of its axes, called by tick() without a virtual call;
 // it may hide clear_ram_state() to clear more (calling this one first) and override the
 // TmclDevice commands it answers differently (MVP COORD on the TMCM-142).
 // What the base reads of its parts:
@@ -75,8 +76,9 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
  public:
   static constexpr std::string_view kName = kFacts.name;
   static constexpr FirmwareIdentity kIdentity = kFacts.identity;
-  static constexpr uint8_t kMotorCount = 1;
   static constexpr NvmLayout kNvmLayout = kFacts.nvm_layout;
+  static constexpr uint8_t kMotorCount = static_cast<uint8_t>(kNvmLayout.motors);
+  static_assert(kMotorCount >= 1 && kMotorCount <= 8, "a TMCL module has 1..8 motors (command 138's mask)");
   static constexpr uint32_t kNvmLayoutVersion = kFacts.nvm_layout_version;
   static constexpr uint32_t kControlTickUs = kFacts.control_tick_us;
 
@@ -108,8 +110,9 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
     tick_fraction_ = 0;
   }
 
-  Axis& axis() { return axis_; }
-  const Axis& axis() const { return axis_; }
+  // The axis of `motor` (0..kMotorCount-1; the engine checked the number a host sent).
+  Axis& axis(uint8_t motor = 0) { return axes_[motor]; }
+  const Axis& axis(uint8_t motor = 0) const { return axes_[motor]; }
   Globals& global_config() { return globals_; }
   const Globals& global_config() const { return globals_; }
   Io& io() { return io_; }
@@ -135,13 +138,13 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
       case move_type::kAbsolute:
         return move_to(motor, value);
       case move_type::kRelative:
-        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(derived().host_actual_position()) +
+        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(derived().host_actual_position(motor)) +
                                                    static_cast<uint32_t>(value)));
       default:
         return Status::kWrongType;
     }
   }
-  bool position_reached(uint8_t /*motor*/) const override { return axis_.position_reached(); }
+  bool position_reached(uint8_t motor) const override { return axes_[motor].position_reached(); }
   Status set_output(uint8_t port, uint8_t bank, int32_t value) override {
     if (bank != io_bank::kDigitalOutputs) return Status::kInvalidValue;
     if (port >= Io::kDigitalOutputCount) return Status::kWrongType;
@@ -169,16 +172,19 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   }
   ProgramMemory* program_memory() override { return &program_; }
   bool autostart() const override { return globals_.auto_start_mode != 0; }
-  bool home_switch_active(uint8_t /*motor*/) const override { return axis_.state.home_switch_active != 0; }
-  bool stop_switch_active(uint8_t /*motor*/, bool left) const override {
-    return (left ? axis_.state.left_switch_active : axis_.state.right_switch_active) != 0;
+  bool home_switch_active(uint8_t motor) const override { return axes_[motor].state.home_switch_active != 0; }
+  bool stop_switch_active(uint8_t motor, bool left) const override {
+    const Axis& axis = axes_[motor];
+    return (left ? axis.state.left_switch_active : axis.state.right_switch_active) != 0;
   }
 
   // ModuleStorage hooks. Power-up: the live state and every setting back to the defaults,
   // before the restore.
   void clear_ram_state() {
-    axis_.reset_state();
-    axis_.config = {};
+    for (Axis& axis : axes_) {
+      axis.reset_state();
+      axis.config = {};
+    }
     globals_ = Globals{};
     runtime_ = TmclRuntime{};
     set_tick_timer_ms(0);
@@ -249,9 +255,9 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
     }
   }
 
-  // The actual position as the host reads it, which MVP REL adds to; a module whose parameter
-  // rows transform it (the TMCM-1636's motor direction, AP 13 of firmware 1.13) hides this.
-  int32_t host_actual_position() const { return axis_.actual_position(); }
+  // The actual position of `motor` as the host reads it, which MVP REL adds to; a module whose
+  // parameter rows transform it (the TMCM-1636's motor direction, AP 13 of firmware 1.13) hides this.
+  int32_t host_actual_position(uint8_t motor) const { return axes_[motor].actual_position(); }
 
  protected:
   // Does not touch `nvm` beyond reading it: call engine().power_up() to start.
@@ -281,7 +287,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   Derived& derived() { return static_cast<Derived&>(*this); }
 
   Io& io_;
-  Axis axis_;
+  std::array<Axis, kMotorCount> axes_{};
   Globals globals_;
   TmclRuntime runtime_;
   uint64_t tick_count_ = 0;

@@ -101,9 +101,9 @@ class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalCon
   const tmcl::FirmwareIdentity& identity() const override { return identity_of(firmware_); }
   // tmcl::TmclModule hook: MVP REL adds to the position as AP 52 reads it (on 1.13 in the host's
   // direction, AP 13, and units, AP 56).
-  int32_t host_actual_position() {
+  int32_t host_actual_position(uint8_t motor) {
     int32_t position = 0;
-    (void)axis_table().read(*this, 0, 52, position);
+    (void)axis_table().read(*this, motor, 52, position);
     return position;
   }
 
