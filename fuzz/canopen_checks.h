@@ -805,6 +805,16 @@ inline can::CanFrame sync_frame(FuzzedDataProvider& in) {
   return frame;
 }
 
+// Any 11-bit frame: any identifier, a remote frame now and then, any length and data.
+inline can::CanFrame any_frame(FuzzedDataProvider& in) {
+  can::CanFrame frame;
+  frame.id = in.ConsumeIntegralInRange<uint32_t>(0, 0x7FF);
+  frame.rtr = in.ConsumeIntegralInRange<int>(0, 7) == 0;
+  frame.dlc = in.ConsumeIntegralInRange<uint8_t>(0, 8);
+  for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+  return frame;
+}
+
 // MOTWIN_FUZZ_TRACE=1 prints every frame in and out: for reading a saved crash input.
 inline void trace(const char* direction, const can::CanFrame& frame) {
   static const bool enabled = std::getenv("MOTWIN_FUZZ_TRACE") != nullptr;

@@ -359,10 +359,7 @@ void run_input(FuzzedDataProvider& in, uint8_t bring_up) {
         break;
       }
       case 10: {  // any identifier
-        frame.id = in.ConsumeIntegralInRange<uint32_t>(0, 0x7FF);
-        frame.rtr = in.ConsumeIntegralInRange<int>(0, 7) == 0;
-        frame.dlc = in.ConsumeIntegralInRange<uint8_t>(0, 8);
-        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+        frame = fuzz::any_frame(in);
         lss = frame.id == canopen::kLssMasterCobId;
         break;
       }

@@ -210,13 +210,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       case 6:  // SYNC
         frame = fuzz::sync_frame(in);
         break;
-      case 7: {  // any identifier
-        frame.id = in.ConsumeIntegralInRange<uint32_t>(0, 0x7FF);
-        frame.rtr = in.ConsumeIntegralInRange<int>(0, 7) == 0;
-        frame.dlc = in.ConsumeIntegralInRange<uint8_t>(0, 8);
-        for (auto& b : frame.data) b = in.ConsumeIntegral<uint8_t>();
+      case 7:  // any identifier
+        frame = fuzz::any_frame(in);
         break;
-      }
       case 8: {  // a board input: switches, supply, temperatures, loads
         const sim::SignalInfo& signal = signals[in.ConsumeIntegralInRange<size_t>(0, signals.size() - 1)];
         double value = in.ConsumeFloatingPointInRange<double>(signal.min, signal.max);
