@@ -82,6 +82,10 @@ enum class Unit : uint8_t {
   kAcceleration,      // stepper acceleration: TMC457 units or µsteps/s² (TMCM-142)
   kTmc457Velocity,    // TMC457 velocity units whatever AP 255 says (TMCM-142)
   kTenMilliseconds,
+  kMicrostepsPerSecond,         // stepper velocity in µsteps/s (TMCM-3216 TMCL)
+  kMicrostepsPerSecondSquared,  // stepper acceleration in µsteps/s² (TMCM-3216 TMCL)
+  kMicrosecond,
+  kThirtyTwoMicroseconds,       // the EightPoint ramp's wait time (TMCM-3216)
 };
 
 constexpr std::string_view unit_symbol(Unit unit) {
@@ -107,6 +111,10 @@ constexpr std::string_view unit_symbol(Unit unit) {
     case Unit::kAcceleration: return "a (AP 255)";
     case Unit::kTmc457Velocity: return "v457";
     case Unit::kTenMilliseconds: return "10ms";
+    case Unit::kMicrostepsPerSecond: return "pps";
+    case Unit::kMicrostepsPerSecondSquared: return "pps/s";
+    case Unit::kMicrosecond: return "us";
+    case Unit::kThirtyTwoMicroseconds: return "32us";
   }
   return "";
 }

@@ -20,23 +20,21 @@
 #include "core/canopen/object_dictionary.h"
 #include "core/modules/tmcm3216/tmcm3216_drive.h"
 #include "core/modules/tmcm3216/tmcm3216_emergencies.h"
+#include "core/modules/tmcm3216/tmcm3216_hardware.h"
 #include "core/modules/tmcm3216/tmcm3216_io.h"
 #include "core/modules/tmcm3216/tmcm3216_stepper.h"
 #include "types/can_frame.h"
 
 namespace motwin::modules::tmcm3216 {
 
-inline constexpr uint8_t kAxisCount = 3;
 inline constexpr uint8_t kPdosPerAxis = 4;       // RPDO/TPDO 1..4, 65..68, 129..132 (manual 1.1)
 inline constexpr uint8_t kMaxMappedObjects = 3;  // "dynamic mapping with max. three mapping entries"
 inline constexpr uint16_t kPdoAxisStride = 0x40; // 1400 -> 1440 -> 1480 (manual 3.1.15)
 inline constexpr size_t kPdoCount = kAxisCount * kPdosPerAxis;  // per direction; PDO K of axis n at n * 4 + K
 static_assert(kPdoCount <= canopen::kNodeMaxPdos);
-// The motion tick (same as the TMCM-142): each tick the sim board senses, tick() runs the drives
-// and steppers, the plants advance kTickUs. The CANopen services keep their millisecond timers:
-// they run once per kServicePeriodUs of ticks (and at once whenever a frame arrives, so that an
-// SDO request is answered within the tick or process() call that sees it).
-inline constexpr uint32_t kTickUs = 50;
+// The motion tick is kTickUs (tmcm3216_hardware.h). The CANopen services keep their millisecond
+// timers: they run once per kServicePeriodUs of ticks (and at once whenever a frame arrives, so
+// that an SDO request is answered within the tick or process() call that sees it).
 inline constexpr uint32_t kServicePeriodUs = canopen::Node::kServicePeriodUs;
 
 using PdoCommunication = canopen::PdoCommunication;
