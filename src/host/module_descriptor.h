@@ -157,8 +157,9 @@ inline Result<const FirmwareGeneration*> find_firmware(const ModuleDescriptor& m
     return Error{"--firmware " + std::string(name) + ": " + std::string(module.name) + " has one firmware, " +
                  std::string(module.firmware)};
   }
+  // By its name, or by the version string `serve` prints for it ("CANopen V1.04", "1636V113").
   for (const FirmwareGeneration& generation : module.firmwares) {
-    if (generation.name == name) return &generation;
+    if (generation.name == name || generation.version == name) return &generation;
   }
   return Error{"unknown firmware \"" + std::string(name) + "\" for " + std::string(module.name) +
                " (choices: " + firmware_names(module) + ")"};

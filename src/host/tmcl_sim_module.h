@@ -3,7 +3,9 @@
 // GP 70 (core/tmcl/can_link.h), the tick loop and the steps of make(). A module is one
 // instantiation (`using Tmcm1636VirtualModule = TmclSimModule<...>`) and its own make(), an
 // explicit specialization in its folder: it chooses the motor, then power_up_on_board() opens
-// eeprom_, builds board_, then device_ and can_, in that order.
+// eeprom_, builds board_, then device_ and can_, in that order. SimIo: the I/O a board over I/O
+// keeps a reference to (the TMCM-1636's, the TMCM-142's); void for a board that holds its own (the
+// TMCM-3216's), which then stamps output changes itself.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +14,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 
 #include "core/tmcl/engine.h"
@@ -49,7 +52,7 @@ class TmclSimModule final : public VirtualModule {
   TmclCanNode* tmcl_can_node() override { return &*can_; }
   uint32_t tick_period_us() const override { return kTickUs; }
   void run_ticks(uint64_t count) override {
-    run_board_ticks(count, tick_count_, kTickUs, kTickS, *board_, *device_, io_);
+    run_board_ticks(count, tick_count_, kTickUs, kTickS, *board_, *device_, output_clock());
   }
   uint64_t tick_count() const override { return tick_count_; }
   board::NonVolatileMemory& nvm() override { return eeprom_.nvm(); }
@@ -57,7 +60,11 @@ class TmclSimModule final : public VirtualModule {
   sim::SignalBoard& signals() override { return *board_; }
 
   Device& device() { return *device_; }
-  SimIo& io() { return io_; }
+  auto& io()
+    requires(!std::is_void_v<SimIo>)
+  {
+    return io_;
+  }
   SimBoard& board() { return *board_; }
 
  private:
@@ -74,11 +81,28 @@ class TmclSimModule final : public VirtualModule {
                                             const FormatImage& format_image, const BuildDevice& build_device,
                                             std::string_view firmware = Device::kIdentity.version_string,
                                             const FirmwareUpdate& firmware_update = {}) {
+    return power_up_on_built_board(
+        options,
+        [&motor](SimIo& io) { return motor ? std::make_unique<SimBoard>(io, *motor) : std::make_unique<SimBoard>(io); },
+        format_image, build_device, firmware, firmware_update);
+  }
+
+  // The same with a board `build_board()` makes (`build_board(io)` with a SimIo): a board on
+  // several motors or one that holds its own I/O.
+  template <class BuildBoard, class FormatImage, class BuildDevice>
+  static MakeModuleResult power_up_on_built_board(const ModuleOptions& options, const BuildBoard& build_board,
+                                                  const FormatImage& format_image, const BuildDevice& build_device,
+                                                  std::string_view firmware = Device::kIdentity.version_string,
+                                                  const FirmwareUpdate& firmware_update = {}) {
     std::unique_ptr<TmclSimModule> module(new TmclSimModule());
     const Result<void> eeprom =
         module->eeprom_.open(options, eeprom_identity_of<Device>(firmware), format_image, firmware_update);
     if (!eeprom) return Error{eeprom.error()};
-    module->board_ = motor ? std::make_unique<SimBoard>(module->io_, *motor) : std::make_unique<SimBoard>(module->io_);
+    if constexpr (std::is_void_v<SimIo>) {
+      module->board_ = build_board();
+    } else {
+      module->board_ = build_board(module->io_);
+    }
     for (const InitialInput& input : options.initial_inputs) module->board_->set_input(input.signal, input.value);
     build_device(*module);
     module->device_->engine().power_up();
@@ -86,7 +110,16 @@ class TmclSimModule final : public VirtualModule {
     return MakeModuleResult(std::move(module));
   }
 
-  SimIo io_;
+  auto& output_clock() {
+    if constexpr (std::is_void_v<SimIo>) {
+      return *board_;
+    } else {
+      return io_;
+    }
+  }
+
+  struct NoIo {};
+  [[no_unique_address]] std::conditional_t<std::is_void_v<SimIo>, NoIo, SimIo> io_;
   std::unique_ptr<SimBoard> board_;
   ModuleEeprom<Device::kNvmLayout.total_size> eeprom_;
   // Constructed once the image is chosen: the device keeps references to it, to io_ and the

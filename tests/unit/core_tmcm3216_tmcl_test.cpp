@@ -259,3 +259,28 @@ TEST(Tmcm3216Tmcl, the_io_banks_map_pytrinamics_ports) {
 
 }  // namespace
 }  // namespace motwin::testing
+
+namespace motwin::testing {
+namespace {
+
+// PyTrinamic's rotate_demo.py: ROR 50000 for 5 s, MST, 5 s, MVP REL by the position read with
+// VMAX 50000: the move ends exactly on the doubled position and AP 8 reads 1.
+TEST(Tmcm3216Tmcl, the_rotate_demo_doubles_its_distance_and_reaches_it) {
+  // The host's requests fall anywhere within the ticks: every phase of the MST and the MVP.
+  for (uint64_t phase = 0; phase < 40; ++phase) {
+    Tmcm3216TmclRig rig;
+    ASSERT_EQ(rig.command(kRor, 0, 0, 50000).status, 100);
+    rig.tick(5000 * 20 + phase);
+    ASSERT_EQ(rig.command(kMst, 0, 0, 0).status, 100);
+    rig.tick(5000 * 20 + 3 * phase);
+    const int32_t position = rig.gap(1, 0);
+    ASSERT_EQ(rig.sap(4, 0, 50000), 100);
+    ASSERT_EQ(rig.command(kMvp, 1, 0, position).status, 100);
+    EXPECT_GE(rig.ms_until_reached(0, 20000), 0)
+        << "phase " << phase << ": AP 1 " << rig.gap(1, 0) << ", target " << 2 * position;
+    EXPECT_EQ(rig.gap(1, 0), 2 * position);
+  }
+}
+
+}  // namespace
+}  // namespace motwin::testing

@@ -38,6 +38,7 @@ ModuleDescriptor fake_canopen_descriptor() {
   descriptor.product_name = "FAKE-1636";
   descriptor.summary = "FAKE-1636 with its CANopen firmware";
   descriptor.firmware = "FAKE CANopen V1.00";
+  descriptor.firmwares = {};  // the descriptor of one firmware
   return descriptor;
 }
 
@@ -139,7 +140,7 @@ TEST(FirmwareDescriptors, unknown_names_give_the_errors_find_firmware_gives) {
   EXPECT_EQ(firmware_listing(fake, "9.9").error(), unknown.error());
 
   // A module with one firmware takes its version string, and nothing else.
-  const ModuleDescriptor& single = canopen_module();
+  const ModuleDescriptor& single = *first_module([](const ModuleDescriptor& m) { return m.firmwares.empty(); });
   const Result<ModuleDescriptor> itself = with_firmware(single, single.firmware);
   ASSERT_TRUE(itself) << itself.error();
   EXPECT_EQ(itself->make, single.make);

@@ -8,6 +8,7 @@
 #include "board/ram_non_volatile_memory.h"
 #include "host/canopen_dictionary_view.h"
 #include "host/module_listing.h"
+#include "host/modules/tmcm3216/tmcm3216_tmcl_virtual_module.h"
 #include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 #include "sim/stepper_motor_selection.h"
 
@@ -53,7 +54,7 @@ ModuleDescriptor tmcm3216_descriptor() {
   return ModuleDescriptor{
       .name = Device::kName,
       .product_name = "TMCM-3216",
-      .summary = "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-402 drive: pp, pv, hm, csp, csv)",
+      .summary = "TMCM-3216 3-axis stepper module, CANopen firmware V1.04 (CiA-402 drive: pp, pv, hm, csp, csv; TMCL: --firmware tmcl)",
       .firmware = Device::kFirmwareVersion,
       .help = R"(A CANopen node on the virtual CAN bus, no TMCL: CiA-301 (SDO, PDO, SYNC, EMCY, LSS) and a
 CiA-402 drive per axis (docs/canopen.md, docs/tmcm-3216-drive.md). --node-id overrides the
@@ -68,6 +69,14 @@ description file (.json, docs/tmcm-142.md, "Motor") for all three axes, or a com
 list, one per axis, e.g. nema17,ideal,nema23 (docs/tmcm-3216-drive.md))"},
       .listing = &object_listing,
       .canopen = &kCanopen,
+      .firmwares = {{.name = "canopen",
+                     .version = Device::kFirmwareVersion,
+                     .help = "the CANopen firmware V1.04 (CiA-301/402, the default)",
+                     .listing = &object_listing},
+                    {.name = "tmcl",
+                     .version = modules::tmcm3216::kTmclFacts.identity.version_string,
+                     .help = "the TMCL firmware (PyTrinamic's TMCM3216 class, Zephyr's driver): three TMCL axes, no CANopen",
+                     .descriptor = &tmcm3216_tmcl_descriptor}},
   };
 }
 
