@@ -3,8 +3,26 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 
 namespace motwin::host {
+
+// Where a virtual module keeps its simulated I/O: `SimIo` for a board over I/O (it keeps a
+// reference to it: the TMCM-1636's, the TMCM-142's), nothing for a board that holds its own (void:
+// the TMCM-3216's).
+struct NoSimIo {};
+template <typename SimIo>
+using SimIoStorage = std::conditional_t<std::is_void_v<SimIo>, NoSimIo, SimIo>;
+
+// What stamps the module's output changes (run_board_ticks' `output_clock`): the I/O, else the board.
+template <typename SimIo, typename Board>
+auto& output_clock_of(SimIoStorage<SimIo>& io, Board& board) {
+  if constexpr (std::is_void_v<SimIo>) {
+    return board;
+  } else {
+    return io;
+  }
+}
 
 // Runs `count` ticks, advancing the module's `tick_count` after each one: what reads the module's
 // clock during a tick (the CAN bus stamping a frame the firmware sends, its bit-time and

@@ -154,17 +154,10 @@ class CanopenSimModule final : public VirtualModule, public CanBusNode, private 
   }
   board::CanControllerStatus status() const override { return bus_.controller_status(); }
 
-  auto& output_clock() {
-    if constexpr (std::is_void_v<SimIo>) {
-      return *board_;
-    } else {
-      return io_;
-    }
-  }
+  auto& output_clock() { return output_clock_of<SimIo>(io_, *board_); }
 
-  struct NoIo {};
   // Before board_, which may keep a reference to it.
-  [[no_unique_address]] std::conditional_t<std::is_void_v<SimIo>, NoIo, SimIo> io_;
+  [[no_unique_address]] SimIoStorage<SimIo> io_;
   // Before device_: the device keeps a reference to its board seam.
   std::unique_ptr<SimBoard> board_;
   ModuleEeprom<nvm_image_size_of<Device>()> eeprom_;  // before device_, which keeps its nvm()

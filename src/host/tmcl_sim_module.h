@@ -110,16 +110,9 @@ class TmclSimModule final : public VirtualModule {
     return MakeModuleResult(std::move(module));
   }
 
-  auto& output_clock() {
-    if constexpr (std::is_void_v<SimIo>) {
-      return *board_;
-    } else {
-      return io_;
-    }
-  }
+  auto& output_clock() { return output_clock_of<SimIo>(io_, *board_); }
 
-  struct NoIo {};
-  [[no_unique_address]] std::conditional_t<std::is_void_v<SimIo>, NoIo, SimIo> io_;
+  [[no_unique_address]] SimIoStorage<SimIo> io_;
   std::unique_ptr<SimBoard> board_;
   ModuleEeprom<Device::kNvmLayout.total_size> eeprom_;
   // Constructed once the image is chosen: the device keeps references to it, to io_ and the
