@@ -287,3 +287,30 @@ TEST(TmclModuleMotors, the_datalogger_resolves_an_axis_channel_of_any_motor) {
 
 }  // namespace
 }  // namespace motwin::testing
+
+namespace motwin::testing {
+namespace {
+
+// The device's own entry points refuse a motor it does not have as the engine does (status 4),
+// for callers that do not go through the engine (the datalogger, tools, the fuzz targets): no
+// read or write of an axis beyond the last, no EEPROM slot beyond the axis area.
+TEST(TmclModuleMotors, direct_calls_for_a_motor_beyond_the_last_are_refused) {
+  ThreeAxisRig rig;
+  const std::vector<uint8_t> image_before(rig.nvm.data(), rig.nvm.data() + rig.nvm.size());
+  int32_t value = 12345;
+  EXPECT_EQ(rig.module.get_axis_parameter(4, 3, value), tmcl::Status::kInvalidValue);
+  EXPECT_EQ(value, 12345);
+  EXPECT_EQ(rig.module.set_axis_parameter(4, 3, 7), tmcl::Status::kInvalidValue);
+  EXPECT_EQ(rig.module.store_axis_parameter(4, 255), tmcl::Status::kInvalidValue);
+  EXPECT_EQ(rig.module.restore_axis_parameter(4, 3), tmcl::Status::kInvalidValue);
+  EXPECT_EQ(rig.module.rotate(3, 10), tmcl::Status::kInvalidValue);
+  EXPECT_EQ(rig.module.move(3, 0, 10), tmcl::Status::kInvalidValue);
+  EXPECT_FALSE(rig.module.position_reached(3));
+  EXPECT_FALSE(rig.module.stop_switch_active(3, true));
+  EXPECT_FALSE(rig.module.home_switch_active(200));
+  EXPECT_EQ(std::vector<uint8_t>(rig.nvm.data(), rig.nvm.data() + rig.nvm.size()), image_before);
+  for (uint8_t motor = 0; motor < kMotors; ++motor) EXPECT_EQ(rig.gap(4, motor), 100);
+}
+
+}  // namespace
+}  // namespace motwin::testing

@@ -105,21 +105,27 @@ class ModuleStorage : public TmclDevice {
   bool last_store_failed() const { return last_store_failed_; }
 
   // TmclDevice: parameters.
+  // A motor the module does not have: status 4, as the engine answers it (these are reached
+  // without the engine too: the datalogger, tools, the fuzz targets).
   Status set_axis_parameter(uint8_t number, uint8_t motor, int32_t value) override {
+    if (motor >= Derived::kMotorCount) return Status::kInvalidValue;
     return derived().axis_table().write(derived(), motor, number, value);
   }
 
   Status get_axis_parameter(uint8_t number, uint8_t motor, int32_t& value) override {
+    if (motor >= Derived::kMotorCount) return Status::kInvalidValue;
     return derived().axis_table().read(derived(), motor, number, value);
   }
 
   Status store_axis_parameter(uint8_t number, uint8_t motor) override {
+    if (motor >= Derived::kMotorCount) return Status::kInvalidValue;
     const auto* row = derived().axis_table().find(number);
     if (row == nullptr || !params::has(row->info.access, params::Access::kEeprom)) return Status::kWrongType;
     return store_parameter(Derived::kNvmLayout.axis_parameter(motor, number), row->binding.get(derived(), motor));
   }
 
   Status restore_axis_parameter(uint8_t number, uint8_t motor) override {
+    if (motor >= Derived::kMotorCount) return Status::kInvalidValue;
     const auto* row = derived().axis_table().find(number);
     if (row == nullptr || !params::has(row->info.access, params::Access::kEeprom)) return Status::kWrongType;
     const int32_t value = stored_value(Derived::kNvmLayout.axis_parameter(motor, number));

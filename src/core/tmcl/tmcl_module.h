@@ -126,7 +126,10 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
                           static_cast<uint8_t>(globals_.telegram_pause_ms)};
   }
   TmclRuntime& runtime() override { return runtime_; }
+  // A motor the module does not have: status 4 (the engine checks first; this guards direct
+  // callers), no position reached and no switch active.
   Status rotate(uint8_t motor, int32_t velocity) override {
+    if (motor >= kMotorCount) return Status::kInvalidValue;
     return derived().axis_table().write(derived(), motor, kFacts.motion.target_velocity, velocity);
   }
   // MST: velocity mode with target 0, stopping with the ramp, as ROR 0.
@@ -134,6 +137,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   // MVP ABS and REL. REL is relative to the actual position and wraps at 32 bits like the
   // position counter.
   Status move(uint8_t motor, uint8_t type, int32_t value) override {
+    if (motor >= kMotorCount) return Status::kInvalidValue;
     switch (type) {
       case move_type::kAbsolute:
         return move_to(motor, value);
@@ -144,7 +148,9 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
         return Status::kWrongType;
     }
   }
-  bool position_reached(uint8_t motor) const override { return axes_[motor].position_reached(); }
+  bool position_reached(uint8_t motor) const override {
+    return motor < kMotorCount && axes_[motor].position_reached();
+  }
   Status set_output(uint8_t port, uint8_t bank, int32_t value) override {
     if (bank != io_bank::kDigitalOutputs) return Status::kInvalidValue;
     if (port >= Io::kDigitalOutputCount) return Status::kWrongType;
@@ -172,8 +178,11 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   }
   ProgramMemory* program_memory() override { return &program_; }
   bool autostart() const override { return globals_.auto_start_mode != 0; }
-  bool home_switch_active(uint8_t motor) const override { return axes_[motor].state.home_switch_active != 0; }
+  bool home_switch_active(uint8_t motor) const override {
+    return motor < kMotorCount && axes_[motor].state.home_switch_active != 0;
+  }
   bool stop_switch_active(uint8_t motor, bool left) const override {
+    if (motor >= kMotorCount) return false;
     const Axis& axis = axes_[motor];
     return (left ? axis.state.left_switch_active : axis.state.right_switch_active) != 0;
   }
