@@ -14,6 +14,7 @@
 #include "core/params/parameter_table.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
+#include "support/tmcl_command.h"
 #include "core/tmcl/tmcl_module.h"
 
 namespace motwin::testing {
@@ -155,11 +156,7 @@ struct ThreeAxisRig {
     engine.power_up();
   }
   tmcl::Reply command(uint8_t cmd, uint8_t type, uint8_t motor, int32_t value) {
-    const auto response =
-        tmcl::serve_serial_frame(engine, tmcl::encode_request(1, tmcl::Instruction{cmd, type, motor, value}), 0);
-    const auto& b = response.bytes;
-    const uint32_t v = (uint32_t{b[4]} << 24) | (uint32_t{b[5]} << 16) | (uint32_t{b[6]} << 8) | b[7];
-    return tmcl::Reply{b[2], b[3], static_cast<int32_t>(v)};
+    return serial_command(engine, cmd, type, motor, value);
   }
   int32_t gap(uint8_t number, uint8_t motor) { return command(kGap, number, motor, 0).value; }
   void run_ticks(int ticks) {

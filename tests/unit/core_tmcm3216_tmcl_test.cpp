@@ -15,6 +15,7 @@
 #include "core/modules/tmcm3216/tmcm3216_tmcl.h"
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
+#include "support/tmcl_command.h"
 #include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
 
 namespace motwin::testing {
@@ -41,11 +42,7 @@ struct Tmcm3216TmclRig {
     module->engine().power_up();
   }
   tmcl::Reply command(uint8_t cmd, uint8_t type, uint8_t motor, int32_t value) {
-    const auto response = tmcl::serve_serial_frame(
-        module->engine(), tmcl::encode_request(1, tmcl::Instruction{cmd, type, motor, value}), 0);
-    const auto& b = response.bytes;
-    const uint32_t v = (uint32_t{b[4]} << 24) | (uint32_t{b[5]} << 16) | (uint32_t{b[6]} << 8) | b[7];
-    return tmcl::Reply{b[2], b[3], static_cast<int32_t>(v)};
+    return serial_command(module->engine(), cmd, type, motor, value);
   }
   int32_t gap(uint8_t number, uint8_t motor = 0) { return command(kGap, number, motor, 0).value; }
   uint8_t sap(uint8_t number, uint8_t motor, int32_t value) { return command(kSap, number, motor, value).status; }
