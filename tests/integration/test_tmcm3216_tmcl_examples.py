@@ -21,6 +21,7 @@ from motwin_harness import (  # noqa: E402
 
 MVP_REL = 1
 TARGET_POSITION, ACTUAL_POSITION, ACTUAL_VELOCITY, MAX_VELOCITY, POSITION_REACHED, RIGHT_ENDSTOP = 0, 1, 3, 4, 8, 10
+RELATIVE_POSITIONING_OPTION = 127
 MICROSTEPS_PER_REVOLUTION = 200 * 256  # a 200-step motor at the default resolution (AP 140 = 8)
 # The scripts' loops have no timeout: the replay gives them this much simulated time.
 POLL_BUDGET_MS = 30000
@@ -54,9 +55,11 @@ def poll_until_reached(c, sample=None):
 
 def test_rotate_demo(motwin):
     """rotate_demo.py: ROR 50000, 5 s, MST, GAP 1 (print), 5 s, move_by(actual position, 50000)
-    (GAP 1, SAP 4 50000, MVP REL by it: the distance doubles), loop on AP 8, 5 s, move_to(0, 100000)
-    (SAP 4 100000, MVP ABS 0), loop on AP 8. The axis ends at 0; the relative move doubled the
-    position the script read."""
+    (GAP 1, SAP 4 50000, MVP REL by it), loop on AP 8, 5 s, move_to(0, 100000) (SAP 4 100000, MVP
+    ABS 0), loop on AP 8. The axis ends at 0. At AP 127's default the relative move adds to the last
+    target (0: nothing moved by position before), as Trinamic's TMCL firmwares do, so it ends where
+    the axis stands; the script's "Doubling moved distance" needs AP 127 = 1, which the replay then
+    sets and checks too (docs/tmcm-3216-tmcl.md "Decisions")."""
     with TempDir() as tmp, Tmcm3216TmclServer(motwin, os.path.join(tmp, "state")) as server, server.tcp() as c:
         expect_reply(c.request(ROR, 0, 0, 50000), ROR, STATUS_OK, what="ROR 50000")
         c.wait_sim_ms(5000)
@@ -69,7 +72,12 @@ def test_rotate_demo(motwin):
         check(4.0 * 50000 < position < 5.5 * 50000, f"AP 1 {position} after 5 s at 50000 pps and the stop")
         c.sap(MAX_VELOCITY, 50000)
         expect_reply(c.request(MVP, MVP_REL, 0, position), MVP, STATUS_OK, what=f"MVP REL {position}")
-        check_equal(c.gap(TARGET_POSITION), 2 * position, "AP 0 after MVP REL by the position read")
+        check_equal(c.gap(TARGET_POSITION), position, "AP 0 after MVP REL by the position read (AP 127 = 0)")
+        poll_until_reached(c)
+        check_equal(c.gap(ACTUAL_POSITION), position, "AP 1 when AP 8 reads 1")
+        c.sap(RELATIVE_POSITIONING_OPTION, 1)
+        expect_reply(c.request(MVP, MVP_REL, 0, position), MVP, STATUS_OK, what=f"MVP REL {position}, AP 127 = 1")
+        check_equal(c.gap(TARGET_POSITION), 2 * position, "AP 0 after MVP REL from the actual position")
         poll_until_reached(c)
         check_equal(c.gap(ACTUAL_POSITION), 2 * position, "AP 1 when AP 8 reads 1 ('doubling moved distance')")
         c.wait_sim_ms(5000)

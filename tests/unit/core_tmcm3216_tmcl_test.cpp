@@ -11,58 +11,10 @@
 #include <memory>
 #include <vector>
 
-#include "board/ram_non_volatile_memory.h"
-#include "core/modules/tmcm3216/tmcm3216_tmcl.h"
-#include "core/tmcl/engine.h"
-#include "core/tmcl/serial_link.h"
-#include "support/tmcl_command.h"
-#include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
+#include "support/tmcm3216_tmcl_rig.h"
 
 namespace motwin::testing {
 namespace {
-
-using modules::tmcm3216::Tmcm3216Tmcl;
-
-constexpr uint8_t kRor = 1, kRol = 2, kMst = 3, kMvp = 4, kSap = 5, kGap = 6, kStap = 7, kSio = 14, kGio = 15;
-
-struct Tmcm3216TmclRig {
-  using Nvm = board::RamNonVolatileMemory<Tmcm3216Tmcl::kNvmLayout.total_size>;
-  static constexpr uint32_t kTickUs = modules::tmcm3216::kTickUs;
-
-  std::unique_ptr<Nvm> nvm = std::make_unique<Nvm>();
-  sim::Tmcm3216SimBoard board;
-  std::unique_ptr<Tmcm3216Tmcl> module;
-
-  Tmcm3216TmclRig() {
-    Tmcm3216Tmcl::format_factory_image(nvm->mutable_data(), nvm->size());
-    power_up();
-  }
-  void power_up() {
-    module = std::make_unique<Tmcm3216Tmcl>(*nvm, board.board());
-    module->engine().power_up();
-  }
-  tmcl::Reply command(uint8_t cmd, uint8_t type, uint8_t motor, int32_t value) {
-    return serial_command(module->engine(), cmd, type, motor, value);
-  }
-  int32_t gap(uint8_t number, uint8_t motor = 0) { return command(kGap, number, motor, 0).value; }
-  uint8_t sap(uint8_t number, uint8_t motor, int32_t value) { return command(kSap, number, motor, value).status; }
-  void tick(uint64_t n = 1) {
-    for (uint64_t i = 0; i < n; ++i) {
-      board.before_tick();
-      module->tick();
-      board.after_tick(kTickUs * 1e-6);
-    }
-  }
-  void run_ms(double ms) { tick(static_cast<uint64_t>(ms * 1000 / kTickUs)); }
-  // Ticks until AP 8 of `motor` reads 1, at most `limit_ms`; the milliseconds it took, or -1.
-  double ms_until_reached(uint8_t motor, double limit_ms) {
-    for (double ms = 0; ms < limit_ms; ms += 1.0) {
-      if (gap(8, motor) == 1) return ms;
-      run_ms(1.0);
-    }
-    return -1;
-  }
-};
 
 TEST(Tmcm3216Tmcl, has_three_motors_and_refuses_a_fourth) {
   Tmcm3216TmclRig rig;
@@ -254,28 +206,28 @@ TEST(Tmcm3216Tmcl, the_io_banks_map_pytrinamics_ports) {
   EXPECT_EQ(rig.command(kGio, 6, 0, 0).status, 3) << "IN0..IN3 are ports 2..5";
 }
 
-}  // namespace
-}  // namespace motwin::testing
-
-namespace motwin::testing {
-namespace {
-
 // PyTrinamic's rotate_demo.py: ROR 50000 for 5 s, MST, 5 s, MVP REL by the position read with
-// VMAX 50000: the move ends exactly on the doubled position and AP 8 reads 1.
-TEST(Tmcm3216Tmcl, the_rotate_demo_doubles_its_distance_and_reaches_it) {
+// VMAX 50000. At AP 127's default the relative move adds to the last target (0: the demo moved
+// nothing before), so it ends where the axis stands and AP 8 reads 1 at once; with AP 127 = 1 (as
+// PyTrinamic's TMCM-1260/1290 examples set it before a move_by) the distance doubles, exactly.
+TEST(Tmcm3216Tmcl, the_rotate_demo_reaches_its_relative_target_at_either_ap127) {
   // The host's requests fall anywhere within the ticks: every phase of the MST and the MVP.
   for (uint64_t phase = 0; phase < 40; ++phase) {
+    const int32_t origin_option = phase % 2 == 0 ? 1 : 0;
     Tmcm3216TmclRig rig;
+    ASSERT_EQ(rig.sap(127, 0, origin_option), 100);
     ASSERT_EQ(rig.command(kRor, 0, 0, 50000).status, 100);
     rig.tick(5000 * 20 + phase);
     ASSERT_EQ(rig.command(kMst, 0, 0, 0).status, 100);
     rig.tick(5000 * 20 + 3 * phase);
     const int32_t position = rig.gap(1, 0);
+    const int32_t target = origin_option == 1 ? 2 * position : position;
     ASSERT_EQ(rig.sap(4, 0, 50000), 100);
     ASSERT_EQ(rig.command(kMvp, 1, 0, position).status, 100);
+    EXPECT_EQ(rig.gap(0, 0), target);
     EXPECT_GE(rig.ms_until_reached(0, 20000), 0)
-        << "phase " << phase << ": AP 1 " << rig.gap(1, 0) << ", target " << 2 * position;
-    EXPECT_EQ(rig.gap(1, 0), 2 * position);
+        << "phase " << phase << ": AP 1 " << rig.gap(1, 0) << ", target " << target;
+    EXPECT_EQ(rig.gap(1, 0), target);
   }
 }
 

@@ -7,8 +7,9 @@ ReferenceSearch::Command ReferenceSearch::start(int32_t mode, double fast_veloci
   fast_ = fast_velocity;
   slow_ = slow_velocity;
   travel_ = 0;
-  phase_ = mode == 1 ? Phase::kFastToLeft : Phase::kFastToRight;
-  return velocity(mode == 1 ? -fast_ : fast_, false);
+  const bool left_only = mode == 1 || mode == 4;
+  phase_ = left_only ? Phase::kFastToLeft : Phase::kFastToRight;
+  return velocity(left_only ? -fast_ : fast_, false);
 }
 
 ReferenceSearch::Command ReferenceSearch::step(const Inputs& in) {
@@ -32,10 +33,10 @@ ReferenceSearch::Command ReferenceSearch::step(const Inputs& in) {
       if (in.left_active) return Command{};
       // The left switching point seen from inside the travel range.
       left_entry_point_ = in.position;
-      if (mode_ >= 2) {
+      if (mode_ == 2 || mode_ == 3) {
         travel_ = static_cast<int32_t>(static_cast<uint32_t>(right_point_) - static_cast<uint32_t>(left_entry_point_));
       }
-      if (mode_ == 3) {
+      if (mode_ == 3 || mode_ == 4) {
         phase_ = Phase::kSlowIntoLeftCam;
         return velocity(-slow_, true);
       }

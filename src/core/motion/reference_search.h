@@ -3,7 +3,9 @@
 //   mode 1: the left switch only;
 //   mode 2: the right switch, then the left switch; the travel between them is measured;
 //   mode 3: as 2, and the reference point is the centre of the left switch's two switching
-//           points (a cam the axis passes through).
+//           points (a cam the axis passes through);
+//   mode 4: as 3 without the right switch: the centre of the left switch, approached from both
+//           sides (the TMCL mode of Trinamic's TMC5160-generation modules, the TMCM-3216's).
 // Switches are approached at the fast speed and hit with a hard stop; each switching point is
 // then found at the slow speed, so its position does not depend on the fast speed. The reference
 // point becomes position 0. A plain state machine: the axis feeds it the switch states and the
@@ -36,7 +38,7 @@ class ReferenceSearch {
     bool position_reached = false;  // for the final move of mode 3
   };
 
-  // Mode 1..3, speeds in µsteps/s (> 0). Returns the first command.
+  // Mode 1..4, speeds in µsteps/s (> 0). Returns the first command.
   Command start(int32_t mode, double fast_velocity, double slow_velocity);
   void stop() { phase_ = Phase::kIdle; }
   bool running() const { return phase_ != Phase::kIdle; }

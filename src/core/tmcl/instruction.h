@@ -80,6 +80,13 @@ inline constexpr uint8_t kRelative = 1;
 inline constexpr uint8_t kCoordinate = 2;
 }  // namespace move_type
 
+// RFS types.
+namespace rfs_type {
+inline constexpr uint8_t kStart = 0;
+inline constexpr uint8_t kStop = 1;
+inline constexpr uint8_t kStatus = 2;  // value 0 when done, non-zero while running
+}  // namespace rfs_type
+
 // Value that commands 137 and 255 require (manual table 10).
 inline constexpr int32_t kResetMagic = 1234;
 

@@ -28,6 +28,7 @@
 #pragma once
 
 #include <array>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
@@ -78,6 +79,10 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   static constexpr FirmwareIdentity kIdentity = kFacts.identity;
   static constexpr NvmLayout kNvmLayout = kFacts.nvm_layout;
   static constexpr uint8_t kMotorCount = static_cast<uint8_t>(kNvmLayout.motors);
+  static constexpr bool kAxisHasReferenceSearch = requires(Axis& a) {
+    { a.start_reference_search() } -> std::same_as<Status>;
+    a.stop_reference_search();
+  };
   static_assert(kMotorCount >= 1 && kMotorCount <= 8, "a TMCL module has 1..8 motors (command 138's mask)");
   static constexpr uint32_t kNvmLayoutVersion = kFacts.nvm_layout_version;
   static constexpr uint32_t kControlTickUs = kFacts.control_tick_us;
@@ -142,7 +147,7 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
       case move_type::kAbsolute:
         return move_to(motor, value);
       case move_type::kRelative:
-        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(derived().host_actual_position(motor)) +
+        return move_to(motor, static_cast<int32_t>(static_cast<uint32_t>(derived().relative_move_origin(motor)) +
                                                    static_cast<uint32_t>(value)));
       default:
         return Status::kWrongType;
@@ -180,6 +185,29 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   bool autostart() const override { return globals_.auto_start_mode != 0; }
   bool home_switch_active(uint8_t motor) const override {
     return motor < kMotorCount && axes_[motor].state.home_switch_active != 0;
+  }
+  // RFS for modules whose axis has a reference search: tmcl::Status start_reference_search()
+  // (status 4 for settings it cannot run with), stop_reference_search(), and
+  // reference_search_running(). Others answer status 2 (TmclDevice).
+  bool reference_search_running(uint8_t motor) const override {
+    if constexpr (kAxisHasReferenceSearch) {
+      return motor < kMotorCount && axes_[motor].reference_search_running();
+    } else {
+      return false;
+    }
+  }
+  Status reference_search(uint8_t motor, uint8_t type, int32_t& value) override {
+    if constexpr (kAxisHasReferenceSearch) {
+      if (motor >= kMotorCount) return Status::kInvalidValue;
+      switch (type) {
+        case rfs_type::kStart: return axes_[motor].start_reference_search();
+        case rfs_type::kStop: axes_[motor].stop_reference_search(); return Status::kOk;
+        case rfs_type::kStatus: value = axes_[motor].reference_search_running() ? 1 : 0; return Status::kOk;
+        default: return Status::kWrongType;
+      }
+    } else {
+      return TmclDevice::reference_search(motor, type, value);
+    }
   }
   bool stop_switch_active(uint8_t motor, bool left) const override {
     if (motor >= kMotorCount) return false;
@@ -267,6 +295,15 @@ class TmclModule : public ModuleStorage<Derived>, public ModuleRows<Derived, Axi
   // The actual position of `motor` as the host reads it, which MVP REL adds to; a module whose
   // parameter rows transform it (the TMCM-1636's motor direction, AP 13 of firmware 1.13) hides this.
   int32_t host_actual_position(uint8_t motor) const { return axes_[motor].actual_position(); }
+  // MVP REL adds to this: the actual position, unless the axis has an origin option (the
+  // TMCM-3216's AP 127).
+  int32_t relative_move_origin(uint8_t motor) {
+    if constexpr (requires(const Axis& a) { a.relative_move_origin(); }) {
+      return axes_[motor].relative_move_origin();
+    } else {
+      return derived().host_actual_position(motor);
+    }
+  }
 
  protected:
   // Does not touch `nvm` beyond reading it: call engine().power_up() to start.

@@ -7,11 +7,6 @@ namespace {
 
 using tmcl::Status;
 
-// RFS types (docs/tmcl-protocol.md "Code tables").
-constexpr uint8_t kRfsStart = 0;
-constexpr uint8_t kRfsStop = 1;
-constexpr uint8_t kRfsStatus = 2;
-
 // The motor byte of `SCO n, 255, 0` / `GCO n, 255, 0`.
 constexpr uint8_t kCoordinateEepromCopy = 255;
 
@@ -118,27 +113,6 @@ Status Tmcm142::move(uint8_t motor, uint8_t move_type, int32_t value) {
   if (move_type != tmcl::move_type::kCoordinate) return TmclModule::move(motor, move_type, value);
   if (value < 0 || value >= kCoordinateCount) return Status::kInvalidValue;
   return move_to(motor, coordinates_[static_cast<size_t>(value)]);
-}
-
-bool Tmcm142::reference_search_running(uint8_t /*motor*/) const { return axis().reference_search_running(); }
-
-Status Tmcm142::reference_search(uint8_t motor, uint8_t type, int32_t& value) {
-  if (motor >= kMotorCount) return Status::kInvalidValue;
-  switch (type) {
-    case kRfsStart:
-      // A search at speed 0 would never end.
-      if (axis().config.reference_fast_pps <= 0.0 || axis().config.reference_slow_pps <= 0.0) return Status::kInvalidValue;
-      axis().start_reference_search();
-      return Status::kOk;
-    case kRfsStop:
-      axis().stop_reference_search();
-      return Status::kOk;
-    case kRfsStatus:
-      value = axis().reference_search_running() ? 1 : 0;
-      return Status::kOk;
-    default:
-      return Status::kWrongType;
-  }
 }
 
 Status Tmcm142::store_coordinate(uint8_t number) {

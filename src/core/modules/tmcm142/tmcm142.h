@@ -99,8 +99,6 @@ class Tmcm142 final : public tmcl::TmclModule<Tmcm142, Tmcm142Axis, GlobalConfig
 
   // TmclDevice: what the TMCL module base does not answer, or answers differently.
   tmcl::Status move(uint8_t motor, uint8_t move_type, int32_t value) override;
-  bool reference_search_running(uint8_t motor) const override;
-  tmcl::Status reference_search(uint8_t motor, uint8_t type, int32_t& value) override;
   tmcl::Status set_coordinate(uint8_t number, uint8_t motor, int32_t position) override;
   tmcl::Status get_coordinate(uint8_t number, uint8_t motor, int32_t& position) override;
   tmcl::Status capture_coordinate(uint8_t number, uint8_t motor) override;

@@ -83,11 +83,13 @@ void Tmcm142Axis::set_encoder_position(int32_t position) {
   state.encoder_position = position;
 }
 
-void Tmcm142Axis::start_reference_search() {
+tmcl::Status Tmcm142Axis::start_reference_search() {
+  if (config.reference_fast_pps <= 0.0 || config.reference_slow_pps <= 0.0) return tmcl::Status::kInvalidValue;
   switch_stopping_ = false;
   search_final_move_ = false;
   const auto command = search_.start(static_cast<int32_t>(config.reference_mode), config.reference_fast_pps, config.reference_slow_pps);
   ramp_.set_velocity_target(command.velocity);
+  return tmcl::Status::kOk;
 }
 
 void Tmcm142Axis::stop_reference_search() {

@@ -11,6 +11,7 @@
 #include "core/motion/easy_pid.h"
 #include "core/motion/reference_search.h"
 #include "core/motion/s_ramp.h"
+#include "core/tmcl/status.h"
 
 namespace motwin::modules::tmcm142 {
 
@@ -142,7 +143,8 @@ class Tmcm142Axis {
   int32_t set_ramp_mode(int32_t mode);  // 0 ok, else the TMCL status 4
   void stop();                          // MST: velocity 0 with the ramp
   void set_encoder_position(int32_t position);
-  void start_reference_search();
+  // RFS START; status 4 for a search at speed 0 (it would never end).
+  tmcl::Status start_reference_search();
   void stop_reference_search();
 
   // One control tick on the power stage: feedback in, drive out.

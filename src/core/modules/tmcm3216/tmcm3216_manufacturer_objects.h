@@ -75,11 +75,11 @@ constexpr EntryRow<Owner> axis_reading(uint16_t index, std::string_view name, Da
 
 template <class Owner>
 SdoAbort check_off_time(Owner&, uint8_t, int64_t v) {
-  return v == 1 ? SdoAbort::kInvalidValue : SdoAbort::kNone;  // 0 or 2..15 (table 102)
+  return valid_chopper_off_time(v) ? SdoAbort::kNone : SdoAbort::kInvalidValue;
 }
 template <class Owner>
 SdoAbort check_global_scaler(Owner&, uint8_t, int64_t v) {
-  return v >= 1 && v <= 31 ? SdoAbort::kInvalidValue : SdoAbort::kNone;  // "1...31 - do not use"
+  return valid_global_current_scaler(v) ? SdoAbort::kNone : SdoAbort::kInvalidValue;
 }
 template <class Owner>
 SdoAbort check_io_mode(Owner&, uint8_t, int64_t v) {

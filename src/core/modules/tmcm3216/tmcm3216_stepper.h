@@ -41,6 +41,11 @@ constexpr bool stall_reaction_of(uint8_t option_code, motion::StallReaction& out
   return true;
 }
 
+// Values the driver refuses within an object's range, for both firmwares' checks: 2097 = 1
+// (table 102: 0 or 2..15) and 20A2 = 1..31 ("do not use").
+constexpr bool valid_chopper_off_time(int64_t value) { return value != 1; }
+constexpr bool valid_global_current_scaler(int64_t value) { return value == 0 || value >= 32; }
+
 // 2005 bits (manual table 62).
 namespace switch_bits = cia402::switch_parameter;
 

@@ -38,10 +38,38 @@ constexpr Binding<Module> stepper_field() {
           }};
 }
 
+// A setting of the motor's stepper whose range has a hole the driver refuses (status 4).
+template <auto Field, bool (*Valid)(int64_t)>
+constexpr Binding<Module> checked_stepper_field() {
+  using Value = std::remove_cvref_t<decltype(std::declval<StepperObjects&>().*Field)>;
+  return {[](Module& m, uint8_t motor) { return static_cast<int32_t>(m.axis(motor).stepper.objects.*Field); },
+          [](Module& m, uint8_t motor, int32_t value) {
+            if (!Valid(value)) return Status::kInvalidValue;
+            m.axis(motor).stepper.objects.*Field = static_cast<Value>(value);
+            return Status::kOk;
+          }};
+}
+
+// An axis setting with values in its range the firmware refuses (status 4).
+template <auto Field, bool (*Valid)(int32_t)>
+constexpr Binding<Module> checked_config_field() {
+  return {[](Module& m, uint8_t motor) { return m.axis(motor).config.*Field; },
+          [](Module& m, uint8_t motor, int32_t value) {
+            if (!Valid(value)) return Status::kInvalidValue;
+            m.axis(motor).config.*Field = value;
+            return Status::kOk;
+          }};
+}
+
 // A reading of the motor's stepper.
 template <auto Get>
 constexpr Binding<Module> stepper_value() {
   return {[](Module& m, uint8_t motor) { return static_cast<int32_t>((m.axis(motor).stepper.*Get)()); }, nullptr};
+}
+
+// AP 207: read and cleared.
+constexpr Binding<Module> error_flags_value() {
+  return {[](Module& m, uint8_t motor) { return m.axis(motor).take_error_flags(); }, nullptr};
 }
 
 // 2010's range (VSTART), and that of the other velocity and acceleration objects 2011..2018.
@@ -75,14 +103,75 @@ const Tmcm3216Tmcl::Table& Tmcm3216Tmcl::axis_parameters() {
     {{19, "start velocity", 0, kStartVelocityMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 2010: VSTART"}, shape_field<&Tmcm3216DriveObjects::start_velocity>()},
     {{20, "stop velocity", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range of 2012, default of 6082: VSTOP, at least VSTART for a position move"}, config_field<&TmclAxisConfig::stop_velocity_pps>()},
     {{21, "ramp wait time", 0, 65535, 0, access("RWE"), Unit::kThirtyTwoMicroseconds, "[Motwin decision] range and default of 2015: rest at 0 before the next move or a reversal"}, shape_field<&Tmcm3216DriveObjects::ramp_wait_time>()},
+    {{22, "high speed threshold", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 20B6 (THIGH): above it the high-speed chopper/fullstep modes (AP 27, 28) apply; stored and reported only"}, stepper_field<&StepperObjects::fullstep_threshold_velocity>()},
+    {{23, "min DcStep speed", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 20B3; stored and reported only"}, stepper_field<&StepperObjects::dcstep_minimum_velocity>()},
     {{24, "right limit switch polarity", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] default of 2005 bit 3: 1 = active while the input is low"}, config_field<&TmclAxisConfig::right_switch_inverted>()},
     {{25, "left limit switch polarity", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] default of 2005 bit 2: 1 = active while the input is low"}, config_field<&TmclAxisConfig::left_switch_inverted>()},
+    {{26, "soft stop", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] default 0: a stop switch or virtual stop stops the axis at once; 1: with the ramp's deceleration (DMAX, D2, D1)"}, config_field<&TmclAxisConfig::soft_stop>()},
+    {{27, "high speed chopper mode", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B7; stored and reported only"}, stepper_field<&StepperObjects::high_speed_chopper>()},
+    {{28, "high speed fullstep mode", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B8; stored and reported only"}, stepper_field<&StepperObjects::high_speed_fullstep>()},
+    {{29, "measured speed", -kRampValueMax, kRampValueMax, 0, access("R"), Unit::kMicrostepsPerSecond, "Velocity measured from the motor's steps (2122)"}, stepper_value<&Tmcm3216Stepper::measured_velocity>()},
+    {{31, "power down ramp", 0, 15, 7, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B9 (IHOLDDELAY): 2^18 clocks per current step down to the standby current"}, stepper_field<&StepperObjects::power_down_ramp>()},
+    {{32, "DcStep time", 0, 1023, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B4; stored and reported only"}, stepper_field<&StepperObjects::dcstep_time>()},
+    {{33, "DcStep StallGuard", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B5; stored and reported only"}, stepper_field<&StepperObjects::dcstep_stallguard>()},
     {{34, "A2", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecondSquared, "[Motwin decision] range and default of 2016: acceleration V1..V2"}, shape_field<&Tmcm3216DriveObjects::a2>()},
     {{35, "V2", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 2017: 0 = no A2/D2 segment"}, shape_field<&Tmcm3216DriveObjects::v2>()},
     {{36, "D2", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecondSquared, "[Motwin decision] range and default of 2018: deceleration V2..V1; 0 with V2 = 0: DMAX"}, shape_field<&Tmcm3216DriveObjects::d2>()},
     {{37, "VMAX minimum time", 0, 65535, 0, access("RWE"), Unit::kMicrosecond, "[Motwin decision] range, default and unit (no CANopen object): the shortest cruise at VMAX"}, config_field<&TmclAxisConfig::cruise_minimum_time_us>()},
+    {{38, "virtual stop left", kMin32, kMax32, 0, access("RWE"), Unit::kMicrosteps, "[Motwin decision] default 0: the axis does not move left of it while AP 41 bit 0 is set"}, config_field<&TmclAxisConfig::virtual_stop_left>()},
+    {{39, "virtual stop right", kMin32, kMax32, 0, access("RWE"), Unit::kMicrosteps, "[Motwin decision] default 0: the axis does not move right of it while AP 41 bit 1 is set"}, config_field<&TmclAxisConfig::virtual_stop_right>()},
+    {{40, "virtual stop flags", 0, 3, 0, access("R"), Unit::kNone, "Bit 0: at or left of the left virtual stop, bit 1: at or right of the right one (enabled stops only)"}, state_value<&TmclAxisState::virtual_stop_flags>()},
+    {{41, "virtual stop enable", 0, 3, 0, access("RWE"), Unit::kNone, "[Motwin decision] default 0: bit 0 enables the left, bit 1 the right virtual stop"}, config_field<&TmclAxisConfig::virtual_stop_enable>()},
+    {{42, "virtual stop encoder mode", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] default 0: the stops compare AP 1; 1: the encoder position AP 209"}, config_field<&TmclAxisConfig::virtual_stop_encoder_mode>()},
+    {{127, "relative positioning option", 0, 2, 0, access("RWE"), Unit::kNone, "[Motwin decision] default 0 as Trinamic's TMCL firmwares: MVP REL adds to 0 the last target (AP 0), 1 the actual position (AP 1), 2 the encoder position (AP 209)"}, config_field<&TmclAxisConfig::relative_positioning_option>()},
     {{140, "microstep resolution", 0, 8, 8, access("RWE"), Unit::kNone, "[Motwin decision] default of 2000: 0 full step, 1 half, 2..8: 4..256 microsteps; takes effect at standstill"}, stepper_field<&StepperObjects::microstep_code>()},
+    {{160, "step interpolation enable", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default; stored and reported only (MicroPlyer of the driver chip)"}, config_field<&TmclAxisConfig::step_interpolation>()},
+    {{162, "chopper blank time", 0, 3, 2, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2092; stored and reported only"}, stepper_field<&StepperObjects::chopper_blank_time>()},
+    {{163, "constant TOff mode", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2093; stored and reported only"}, stepper_field<&StepperObjects::chopper_mode>()},
+    {{164, "disable fast decay comparator", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2094; stored and reported only"}, stepper_field<&StepperObjects::chopper_fast_decay_comparator_off>()},
+    {{165, "chopper hysteresis end", -3, 12, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2095; stored and reported only"}, stepper_field<&StepperObjects::chopper_hysteresis_end>()},
+    {{166, "chopper hysteresis start", 0, 8, 3, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2096; stored and reported only"}, stepper_field<&StepperObjects::chopper_hysteresis_start>()},
+    {{167, "TOff", 0, 15, 5, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2097: 0 switches the bridges off (the motor freewheels), 1 is refused"}, checked_stepper_field<&StepperObjects::chopper_off_time, &valid_chopper_off_time>()},
+    {{168, "smartEnergy current minimum", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2098 (SEIMIN): 0 half, 1 a quarter of the run current"}, stepper_field<&StepperObjects::coolstep_current_minimum>()},
+    {{169, "smartEnergy current down step", 0, 3, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2099 (SEDN)"}, stepper_field<&StepperObjects::coolstep_down_step>()},
+    {{170, "smartEnergy hysteresis", 0, 15, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 209A (SEMAX)"}, stepper_field<&StepperObjects::coolstep_hysteresis>()},
+    {{171, "smartEnergy current up step", 0, 3, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 209B (SEUP)"}, stepper_field<&StepperObjects::coolstep_up_step>()},
+    {{172, "smartEnergy hysteresis start", 0, 15, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 209C (SEMIN): 0 = CoolStep off"}, stepper_field<&StepperObjects::coolstep_hysteresis_start>()},
+    {{173, "StallGuard2 filter enable", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 209D (SFILT)"}, stepper_field<&StepperObjects::stallguard2_filter>()},
+    {{174, "StallGuard2 threshold", -63, 63, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 209E (SGT)"}, stepper_field<&StepperObjects::stallguard2_threshold>()},
+    {{178, "global current scaler", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20A2: 0 = 256/256, 32..255 = x/256, 1..31 refused"}, checked_stepper_field<&StepperObjects::global_current_scaler, &valid_global_current_scaler>()},
+    {{179, "full scale current range", 0, 3, 3, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20A3: 0 1 A, 1 2 A, 2 and 3 3 A peak"}, stepper_field<&StepperObjects::current_range>()},
+    {{180, "smartEnergy actual current", 0, 31, 0, access("R"), Unit::kNone, "Current scale CS the driver applies now (CoolStep, standby)"}, stepper_value<&Tmcm3216Stepper::current_scale>()},
+    {{181, "stop on stall", 0, kMax32, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 20A4: above this velocity a StallGuard stall stops the axis (AP 207 bit 0); 0 = off"}, stepper_field<&StepperObjects::stop_on_stall_velocity>()},
+    {{182, "smartEnergy threshold speed", 0, kMax32, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 20A5: CoolStep above this velocity"}, stepper_field<&StepperObjects::coolstep_threshold_velocity>()},
+    {{185, "passive fast decay time", 0, 15, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default; stored and reported only"}, config_field<&TmclAxisConfig::passive_fast_decay_time>()},
+    {{186, "PWM threshold speed", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 20B0: StealthChop below this velocity (0: off)"}, stepper_field<&StepperObjects::pwm_threshold_velocity>()},
+    {{187, "PWM gradient", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B1: 0 = StealthChop off"}, stepper_field<&StepperObjects::pwm_gradient>()},
+    {{188, "PWM amplitude", 0, 255, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20B2"}, stepper_field<&StepperObjects::pwm_amplitude>()},
+    {{189, "PWM scale", 0, 255, 0, access("R"), Unit::kNone, "StealthChop PWM scale (2121)"}, stepper_value<&Tmcm3216Stepper::pwm_scale>()},
+    {{190, "PWM mode", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default; stored and reported only (StealthChop follows AP 186, 187)"}, config_field<&TmclAxisConfig::pwm_mode>()},
+    {{191, "PWM frequency", 0, 3, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of the TMC5160's PWM_FREQ; stored and reported only"}, config_field<&TmclAxisConfig::pwm_frequency>()},
+    {{192, "PWM autoscale", 0, 1, 1, access("RWE"), Unit::kNone, "[Motwin decision] range and default of the TMC5160's PWM_AUTOSCALE; stored and reported only"}, config_field<&TmclAxisConfig::pwm_autoscale>()},
+    {{193, "reference search mode", 1, 136, 1, access("RWE"), Unit::kNone, "[Motwin decision] default 1: 1 left switch, 2 right then left (AP 196), 3 as 2 and the left switch's centre, 4 the left switch's centre, 5/6 home switch negative/positive reversing at the stop switch, 7/8 home switch positive/negative ignoring the stop switches, 9/10 the encoder's null channel positive/negative; +64 the right switch for the left (1..4), +128 the home switch active low (5..8)"}, checked_config_field<&TmclAxisConfig::reference_search_mode, &reference_mode::valid>()},
+    {{194, "reference search speed", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 6099 sub 1: the fast search for the switch; 0 refuses RFS START"}, config_field<&TmclAxisConfig::reference_search_speed_pps>()},
+    {{195, "reference switch speed", 0, kRampValueMax, 0, access("RWE"), Unit::kMicrostepsPerSecond, "[Motwin decision] range and default of 6099 sub 2: the slow approach of the switching point and the null channel"}, config_field<&TmclAxisConfig::reference_switch_speed_pps>()},
+    {{196, "reference switch distance", kMin32, kMax32, 0, access("R"), Unit::kMicrosteps, "Modes 2 and 3: from the left to the right switching point"}, state_value<&TmclAxisState::reference_switch_distance>()},
+    {{197, "last reference position", kMin32, kMax32, 0, access("R"), Unit::kMicrosteps, "AP 1 just before the reference search set it to 0"}, state_value<&TmclAxisState::last_reference_position>()},
+    {{201, "encoder mode", 0, 1023, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default; stored and reported only (the encoder counts A/B, AP 210 scales it)"}, config_field<&TmclAxisConfig::encoder_mode>()},
+    {{202, "fullstep resolution", 0, 65535, 200, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 2001: full steps per motor revolution"}, stepper_field<&StepperObjects::full_steps_per_revolution>()},
+    {{204, "freewheeling mode", 0, 3, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default; stored and reported only (0 normal, 1 freewheeling, 2/3 coils shorted at standby current 0)"}, config_field<&TmclAxisConfig::freewheeling_mode>()},
     {{206, "load value", 0, 1023, 0, access("R"), Unit::kNone, "StallGuard2 load value (2101)"}, stepper_value<&Tmcm3216Stepper::load_value>()},
+    {{207, "error flags", 0, 3, 0, access("R"), Unit::kNone, "Bit 0: stopped by a stall (AP 181), bit 1: stopped by an encoder deviation (AP 212); cleared when read"}, error_flags_value()},
+    {{208, "driver error flags", 0, 255, 0, access("R"), Unit::kNone, "The driver's error flags (2102's bits: overcurrent, open load, temperature, undervoltage)"}, stepper_value<&Tmcm3216Stepper::driver_error_flags>()},
+    {{209, "encoder position", kMin32, kMax32, 0, access("RW"), Unit::kMicrosteps, "Encoder position in microsteps (scaled by AP 210); a write sets it"}, axis_command<&Tmcm3216TmclAxis::encoder_position, &Tmcm3216TmclAxis::set_encoder_position>()},
+    {{210, "encoder resolution", 0, kMax32, 1, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 608F sub 1: encoder counts per motor revolution"}, stepper_field<&StepperObjects::encoder_increments>()},
+    {{212, "max encoder deviation", 0, kMax32, 0, access("RWE"), Unit::kMicrosteps, "[Motwin decision] default 0 (off): AP 1 and AP 209 further apart stop the axis (AP 207 bit 1)"}, config_field<&TmclAxisConfig::max_encoder_deviation>()},
+    {{214, "power down delay", 0, 400, 200, access("RWE"), Unit::kTenMilliseconds, "[Motwin decision] range and default of 2089: standstill time before the standby current"}, stepper_field<&StepperObjects::standby_delay_10ms>()},
+    {{220, "StallGuard4 result", 0, 511, 0, access("R"), Unit::kNone, "StallGuard4 result in StealthChop (210A)"}, stepper_value<&Tmcm3216Stepper::stallguard4_result>()},
+    {{221, "StallGuard4 threshold", 0, 511, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20A8: a stall when the result falls below it"}, stepper_field<&StepperObjects::stallguard4_threshold>()},
+    {{222, "StallGuard4 filter enable", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20A9"}, stepper_field<&StepperObjects::stallguard4_filter>()},
+    {{223, "StallGuard4 angle offset", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] range and default of 20AA; stored and reported only"}, stepper_field<&StepperObjects::stallguard4_angle_offset>()},
+    {{251, "reverse shaft", 0, 1, 0, access("RWE"), Unit::kNone, "[Motwin decision] default 0: 1 turns the motor the other way for the same positions"}, config_field<&TmclAxisConfig::reverse_shaft>()},
   };
   // clang-format on
   static constexpr Table kTable = params::sorted_table<Module>(kRows);
