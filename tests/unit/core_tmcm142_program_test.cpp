@@ -8,6 +8,7 @@
 #include "core/modules/tmcm142/tmcm142_hardware.h"
 #include "core/tmcl/instruction.h"
 #include "core/tmcl/interpreter.h"
+#include "support/tmcl_command.h"
 #include "support/tmcm142_rig.h"
 
 namespace motwin::testing {
@@ -22,11 +23,7 @@ constexpr uint8_t kWaitLimitSwitch = 3;
 constexpr uint8_t kWaitReferenceSearch = 4;
 constexpr uint8_t kJcEto = 8;
 
-void download(Tmcm142Rig& rig, std::initializer_list<Instruction> program) {
-  ASSERT_EQ(rig.command(cmd::kEnterDownloadMode, 0, 0, 0).status, kOk);
-  for (const auto& in : program) ASSERT_EQ(rig.command(in.command, in.type, in.motor_bank, in.value).status, 101);
-  ASSERT_EQ(rig.command(cmd::kExitDownloadMode, 0, 0, 0).status, kOk);
-}
+void download(Tmcm142Rig& rig, std::initializer_list<Instruction> program) { download_program(rig, program); }
 
 // Speeds in µsteps/s (unit mode 1), trapezoid corners.
 void use_pps(Tmcm142Rig& rig, int32_t vmax, int32_t acceleration) {

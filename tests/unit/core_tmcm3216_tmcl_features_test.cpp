@@ -307,5 +307,57 @@ TEST(Tmcm3216TmclFeatures, rfs_refuses_what_it_cannot_run_and_stops_on_request) 
   EXPECT_NE(rig.gap(1, 0), 0) << "no reference set";
 }
 
+// Bank 3 and the vectors of PyTrinamic's GP3 list for three axes: the stop switches of axis 1
+// (29 left, 30 right), Input_0 (39: IN0, GIO port 2), and position reached per motor (3 + m).
+TEST(Tmcm3216TmclFeatures, interrupts_of_each_axis_and_input_run_their_routines) {
+  Tmcm3216TmclRig rig;
+  namespace cmd = tmcl::command;
+  constexpr uint8_t kBank3 = 3, kVars = 2;
+  download_program(rig, {
+      {cmd::kSgp, 29, kBank3, 1},   // 0: axis 1 left stop switch: rising edge
+      {cmd::kSgp, 39, kBank3, 3},   // 1: Input_0: both edges
+      {cmd::kVect, 29, 0, 10},      // 2
+      {cmd::kVect, 39, 0, 14},      // 3
+      {cmd::kVect, 5, 0, 18},       // 4: position reached, motor 2
+      {cmd::kEi, 29, 0, 0},         // 5
+      {cmd::kEi, 39, 0, 0},         // 6
+      {cmd::kEi, 5, 0, 0},          // 7
+      {cmd::kEi, 255, 0, 0},        // 8
+      {cmd::kJa, 0, 0, 9},          // 9: idle
+      {cmd::kGgp, 0, kVars, 0},     // 10: var 0 counts axis 1's left switch
+      {cmd::kCalc, 0, 0, 1},        // 11
+      {cmd::kAgp, 0, kVars, 0},     // 12
+      {cmd::kReti, 0, 0, 0},        // 13
+      {cmd::kGgp, 1, kVars, 0},     // 14: var 1 counts IN0's edges
+      {cmd::kCalc, 0, 0, 1},        // 15
+      {cmd::kAgp, 1, kVars, 0},     // 16
+      {cmd::kReti, 0, 0, 0},        // 17
+      {cmd::kGap, 1, 2, 0},         // 18: var 2 = motor 2's position on arrival
+      {cmd::kAgp, 2, kVars, 0},     // 19
+      {cmd::kReti, 0, 0, 0},        // 20
+  });
+  EXPECT_EQ(rig.command(cmd::kGgp, 31, kBank3, 0).status, 100) << "axis 2's left switch";
+  EXPECT_EQ(rig.command(cmd::kGgp, 33, kBank3, 0).status, 3) << "no fourth axis";
+  ASSERT_EQ(rig.command(cmd::kRunApplication, 1, 0, 0).status, 100);
+  rig.run_ms(20);
+  rig.board.set_input("AXIS0_REF_L", 1);  // another axis' switch: no interrupt
+  rig.run_ms(20);
+  EXPECT_EQ(rig.command(cmd::kGgp, 0, kVars, 0).value, 0);
+  rig.board.set_input("AXIS1_REF_L", 1);
+  rig.run_ms(20);
+  EXPECT_EQ(rig.command(cmd::kGgp, 0, kVars, 0).value, 1);
+  rig.board.set_input("AXIS1_REF_L", 0);
+  rig.run_ms(20);
+  EXPECT_EQ(rig.command(cmd::kGgp, 0, kVars, 0).value, 1) << "rising edge only";
+  rig.board.set_input("DIO0", 1);
+  rig.run_ms(20);
+  rig.board.set_input("DIO0", 0);
+  rig.run_ms(20);
+  EXPECT_EQ(rig.command(cmd::kGgp, 1, kVars, 0).value, 2) << "IN0 (DIO0): both edges";
+  ASSERT_EQ(rig.command(kMvp, 0, 2, 3000).status, 100);
+  rig.run_ms(1000);
+  EXPECT_EQ(rig.command(cmd::kGgp, 2, kVars, 0).value, 3000) << "motor 2 arrived";
+}
+
 }  // namespace
 }  // namespace motwin::testing

@@ -75,6 +75,8 @@ class TmclDevice {
   virtual bool home_switch_active(uint8_t /*motor*/) const { return false; }
   virtual bool stop_switch_active(uint8_t /*motor*/, bool /*left*/) const { return false; }
   virtual bool reference_search_running(uint8_t /*motor*/) const { return false; }
+  // The GIO bank-0 port of input interrupt vector 39 (the next vectors take the next ports).
+  virtual uint8_t first_interrupt_input_port() const { return 0; }
 
   // RFS (13): type 0 START, 1 STOP, 2 STATUS (value 0 when done, non-zero while running).
   // Modules without a reference search answer status 2 (invalid command).

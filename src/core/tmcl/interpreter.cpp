@@ -296,9 +296,7 @@ Status TmclInterpreter::set_interrupt_parameter(uint8_t number, int32_t value) {
     timer_period_ms_[number] = static_cast<uint32_t>(value);
     return Status::kOk;
   }
-  const bool is_trigger = number == vector::kLeftStopSwitch0 || number == vector::kRightStopSwitch0 ||
-                          (number >= vector::kInput0 && number < vector::kInput0 + vector::kInputCount);
-  if (!is_trigger) return Status::kWrongType;
+  if (!is_edge_trigger(number)) return Status::kWrongType;
   if (value < 0 || value > 3) return Status::kInvalidValue;
   edge_trigger_[number] = static_cast<uint8_t>(value);
   return Status::kOk;
@@ -309,12 +307,17 @@ Status TmclInterpreter::get_interrupt_parameter(uint8_t number, int32_t& value) 
     value = static_cast<int32_t>(timer_period_ms_[number]);
     return Status::kOk;
   }
-  if (number >= vector::kCount || (number != vector::kLeftStopSwitch0 && number != vector::kRightStopSwitch0 &&
-                                   number < vector::kInput0)) {
-    return Status::kWrongType;
-  }
+  if (!is_edge_trigger(number)) return Status::kWrongType;
   value = edge_trigger_[number];
   return Status::kOk;
+}
+
+bool TmclInterpreter::is_edge_trigger(uint8_t number) const {
+  const uint8_t motors = device_.motor_count() < vector::kMaxMotors ? device_.motor_count() : vector::kMaxMotors;
+  if (number >= vector::kLeftStopSwitch0 && number <= vector::right_stop_switch(static_cast<uint8_t>(motors - 1))) {
+    return true;
+  }
+  return number >= vector::kInput0 && number < vector::kInput0 + vector::kInputCount;
 }
 
 // Raises pending flags for timers that expired and edges that match their trigger.
@@ -341,14 +344,20 @@ void TmclInterpreter::sample_interrupt_sources(uint64_t now_us) {
       if (enabled_[vector]) pending_[vector] = true;
     }
   };
-  edge(vector::kPositionReached0, device_.position_reached(0), 1);
-  edge(vector::kLeftStopSwitch0, device_.stop_switch_active(0, true), edge_trigger_[vector::kLeftStopSwitch0]);
-  edge(vector::kRightStopSwitch0, device_.stop_switch_active(0, false), edge_trigger_[vector::kRightStopSwitch0]);
+  const uint8_t motors = device_.motor_count() < vector::kMaxMotors ? device_.motor_count() : vector::kMaxMotors;
+  for (uint8_t m = 0; m < motors; ++m) {
+    const uint8_t left = vector::left_stop_switch(m);
+    const uint8_t right = vector::right_stop_switch(m);
+    edge(vector::position_reached(m), device_.position_reached(m), 1);
+    edge(left, device_.stop_switch_active(m, true), edge_trigger_[left]);
+    edge(right, device_.stop_switch_active(m, false), edge_trigger_[right]);
+  }
   for (uint8_t i = 0; i < vector::kInputCount; ++i) {
     const uint8_t v = static_cast<uint8_t>(vector::kInput0 + i);
     if (edge_trigger_[v] == 0) continue;
     int32_t level = 0;
-    if (device_.get_input(i, 0, level) != Status::kOk) continue;
+    const uint8_t port = static_cast<uint8_t>(device_.first_interrupt_input_port() + i);
+    if (device_.get_input(port, 0, level) != Status::kOk) continue;
     edge(v, level != 0, edge_trigger_[v]);
   }
 }

@@ -31,7 +31,9 @@ enum class StopReason : uint8_t {
 
 const char* stop_reason_text(StopReason reason);
 
-// Interrupt vectors (TMCL V4-generation numbering, docs/tmcl-programs.md).
+// Interrupt vectors (TMCL V4-generation numbering, docs/tmcl-programs.md). Per motor m of a
+// module with several: position reached 3 + m, left stop switch 27 + 2m, right 28 + 2m (up to
+// six motors, as Trinamic's multi-axis modules number them).
 namespace vector {
 inline constexpr uint8_t kTimer0 = 0;
 inline constexpr uint8_t kTimer1 = 1;
@@ -39,6 +41,10 @@ inline constexpr uint8_t kTimer2 = 2;
 inline constexpr uint8_t kPositionReached0 = 3;
 inline constexpr uint8_t kLeftStopSwitch0 = 27;
 inline constexpr uint8_t kRightStopSwitch0 = 28;
+inline constexpr uint8_t kMaxMotors = 6;
+constexpr uint8_t position_reached(uint8_t motor) { return static_cast<uint8_t>(kPositionReached0 + motor); }
+constexpr uint8_t left_stop_switch(uint8_t motor) { return static_cast<uint8_t>(kLeftStopSwitch0 + 2 * motor); }
+constexpr uint8_t right_stop_switch(uint8_t motor) { return static_cast<uint8_t>(kRightStopSwitch0 + 2 * motor); }
 inline constexpr uint8_t kInput0 = 39;
 inline constexpr uint8_t kInputCount = 8;
 inline constexpr uint8_t kCount = kInput0 + kInputCount;
@@ -65,8 +71,8 @@ class TmclInterpreter {
   uint32_t stop_address() const { return stop_address_; }
   uint64_t instructions_executed() const { return instructions_executed_; }
 
-  // Bank 3: timer periods (ms) 0..2, edge triggers for stop switches 27/28 and inputs 39..46
-  // (0 off, 1 rising, 2 falling, 3 both).
+  // Bank 3: timer periods (ms) 0..2, edge triggers for the stop switches (27/28, + 2 per motor)
+  // and inputs 39..46 (0 off, 1 rising, 2 falling, 3 both).
   Status set_interrupt_parameter(uint8_t number, int32_t value);
   Status get_interrupt_parameter(uint8_t number, int32_t& value) const;
 
@@ -96,6 +102,8 @@ class TmclInterpreter {
   void begin_wait(const Instruction& instruction, uint64_t now_us);
   void service_wait(uint64_t now_us);
   void sample_interrupt_sources(uint64_t now_us);
+  // A bank-3 number that sets an edge trigger: a stop switch of a motor the module has, an input.
+  bool is_edge_trigger(uint8_t number) const;
   bool enter_pending_interrupt();
   int32_t operand_or_accumulator(int32_t value) const;
 

@@ -89,6 +89,8 @@ class Tmcm3216Tmcl final
   // tmcl::TmclModule hook: one 50 µs tick of the three axes, and the brake outputs they drive.
   void tick_axis();
 
+  // TmclDevice: PyTrinamic's GP3 list names vectors 39..42 Input_0..3, which are GIO ports 2..5.
+  uint8_t first_interrupt_input_port() const override { return 2; }
   // TmclDevice: command 157.
   tmcl::Status get_info(uint8_t type, uint8_t /*motor*/, int32_t& value) override { return firmware_info(type, value); }
 
