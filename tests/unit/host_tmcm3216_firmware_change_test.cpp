@@ -5,12 +5,15 @@
 // really damaged image still is.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "core/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "host/eeprom_file.h"
 #include "host/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "host/modules/tmcm3216/tmcm3216_tmcl_virtual_module.h"
@@ -240,6 +243,64 @@ TEST(Tmcm3216FirmwareChange, an_unknown_firmware_or_layout_is_not_taken_over) {
   EXPECT_FALSE(tmcm3216_canopen_image_from_tmcl({"3216V100", 2, tmcl}, canopen.data(), canopen.size()));
   EXPECT_FALSE(tmcm3216_tmcl_image_from_canopen({"3216V100", 1, canopen}, tmcl.data(), tmcl.size()));
   EXPECT_TRUE(tmcm3216_tmcl_image_from_canopen({"CANopen V1.04", 1, canopen}, tmcl.data(), tmcl.size()));
+}
+
+}  // namespace
+}  // namespace motwin::host
+
+namespace motwin::host {
+namespace {
+
+// The CANopen objects (2xxx, 6xxx) a TMCL row's description names.
+std::vector<uint16_t> objects_named(std::string_view description) {
+  std::vector<uint16_t> objects;
+  const auto hex = [](char c) { return (c >= '0' && c <= '9') || (c >= 'A' && c <= 'F'); };
+  for (size_t i = 0; i + 4 <= description.size(); ++i) {
+    const bool starts_word = i == 0 || !std::isalnum(static_cast<unsigned char>(description[i - 1]));
+    const bool ends_word = i + 4 == description.size() || !std::isalnum(static_cast<unsigned char>(description[i + 4]));
+    if (!starts_word || !ends_word || (description[i] != '2' && description[i] != '6')) continue;
+    if (!hex(description[i + 1]) || !hex(description[i + 2]) || !hex(description[i + 3])) continue;
+    objects.push_back(static_cast<uint16_t>(std::stoul(std::string(description.substr(i, 4)), nullptr, 16)));
+  }
+  return objects;
+}
+
+// The table keeps up with the TMCL parameter table: every stored AP whose description names a
+// CANopen object has a row with one of those objects (a new AP that forgets its row fails here),
+// and every row is a stored AP and a stored per-axis object of every axis.
+TEST(Tmcm3216FirmwareChange, the_shared_table_covers_every_stored_ap_that_names_an_object) {
+  using modules::tmcm3216::kSharedAxisSettings;
+  for (const auto& row : Tmcm3216Tmcl::axis_parameters().rows()) {
+    if (!tmcl::is_stored_parameter(row.info)) continue;
+    const std::vector<uint16_t> named = objects_named(row.info.description);
+    if (named.empty()) continue;
+    bool found = false;
+    for (const params::SharedAxisSetting& shared : kSharedAxisSettings) {
+      if (shared.parameter != row.info.number) continue;
+      found = true;
+      EXPECT_NE(std::find(named.begin(), named.end(), shared.index), named.end())
+          << "AP " << row.info.number << " maps to " << std::hex << shared.index << ", its description: "
+          << row.info.description;
+    }
+    EXPECT_TRUE(found) << "AP " << row.info.number << " names a CANopen object but has no row: "
+                       << row.info.description;
+  }
+  testing::ScratchDirectory dir;
+  std::vector<std::string> log;
+  Canopen canopen = open_canopen(dir.path(), log);
+  ASSERT_NE(canopen.module, nullptr);
+  for (const params::SharedAxisSetting& shared : kSharedAxisSettings) {
+    const auto* parameter = Tmcm3216Tmcl::axis_parameters().find(shared.parameter);
+    ASSERT_NE(parameter, nullptr) << "AP " << int{shared.parameter};
+    EXPECT_TRUE(tmcl::is_stored_parameter(parameter->info)) << "AP " << int{shared.parameter};
+    for (uint8_t axis = 0; axis < modules::tmcm3216::kAxisCount; ++axis) {
+      canopen::ObjectRef ref;
+      ASSERT_EQ(canopen.device().dictionary().find(shared.index_of(axis), shared.sub, ref), canopen::SdoAbort::kNone)
+          << std::hex << shared.index_of(axis);
+      EXPECT_EQ(ref.axis, axis) << std::hex << shared.index_of(axis);
+      EXPECT_EQ(ref.info->storage, canopen::StorageGroup::kAxis) << std::hex << shared.index_of(axis);
+    }
+  }
 }
 
 }  // namespace
