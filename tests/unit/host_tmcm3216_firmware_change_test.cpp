@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -98,116 +99,118 @@ bool damaged_exists(const testing::ScratchDirectory& dir) {
   return std::filesystem::exists(image_in(dir).string() + ".damaged");
 }
 
+// An AP of a motor, or a CANopen object (at its axis' index), with a value.
+struct ApValue {
+  uint8_t number;
+  uint8_t motor;
+  int64_t value;
+};
+struct ObjectValue {
+  uint16_t index;
+  int64_t value;
+};
+
+void expect_aps(Tmcl& tmcl, std::initializer_list<ApValue> expected) {
+  for (const ApValue& e : expected) {
+    EXPECT_EQ(tmcl.gap(e.number, e.motor), e.value) << "AP " << int{e.number} << " of motor " << int{e.motor};
+  }
+}
+
+void expect_objects(Canopen& canopen, std::initializer_list<ObjectValue> expected) {
+  for (const ObjectValue& e : expected) EXPECT_EQ(canopen.read(e.index), e.value) << std::hex << e.index;
+}
+
+// The one line of a change, and nothing set aside.
+void expect_taken_over(const std::vector<std::string>& log, const char* line, const testing::ScratchDirectory& dir) {
+  EXPECT_EQ(log.size(), 1u);
+  EXPECT_EQ(lines_with(log, line), 1u) << (log.empty() ? "" : log[0]);
+  EXPECT_FALSE(damaged_exists(dir));
+}
+
 TEST(Tmcm3216FirmwareChange, tmcl_settings_survive_on_the_canopen_firmware_and_back) {
   testing::ScratchDirectory dir;
   {
     std::vector<std::string> log;
     Tmcl tmcl = open_tmcl(dir.path(), log);
     ASSERT_NE(tmcl.module, nullptr);
-    tmcl.sap_stap(4, 1, 12345);   // 6081 of axis 1
-    tmcl.sap_stap(5, 1, 2222);    // 6083
-    tmcl.sap_stap(17, 1, 3333);   // 6084
-    tmcl.sap_stap(6, 1, 200);     // 2003
-    tmcl.sap_stap(140, 1, 6);     // 2000
-    tmcl.sap_stap(35, 1, 40000);  // 2017
-    tmcl.sap_stap(21, 2, 77);     // 2015 of axis 2
-    tmcl.sap_stap(12, 1, 1);      // 2005 bit 1
-    tmcl.sap_stap(25, 1, 1);      // 2005 bit 2
-    tmcl.sap_stap(37, 1, 500);    // no CANopen object
+    // 6081, 6083, 6084, 2003, 2000, 2017 of axis 1, 2015 of axis 2, 2005 bits 1 and 2 of axis 1;
+    // AP 37 has no CANopen object.
+    for (const ApValue& set : {ApValue{4, 1, 12345}, {5, 1, 2222}, {17, 1, 3333}, {6, 1, 200}, {140, 1, 6},
+                               {35, 1, 40000}, {21, 2, 77}, {12, 1, 1}, {25, 1, 1}, {37, 1, 500}}) {
+      tmcl.sap_stap(set.number, set.motor, static_cast<int32_t>(set.value));
+    }
     ASSERT_EQ(tmcl.device().set_axis_parameter(4, 0, 777), tmcl::Status::kOk) << "set, never stored";
   }
   {
     std::vector<std::string> log;
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
-    EXPECT_EQ(log.size(), 1u);
-    EXPECT_EQ(lines_with(log, kTakeOverToCanopen), 1u) << (log.empty() ? "" : log[0]);
-    EXPECT_FALSE(damaged_exists(dir));
-    EXPECT_EQ(canopen.read(0x6081 + 0x800), 12345);
-    EXPECT_EQ(canopen.read(0x6083 + 0x800), 2222);
-    EXPECT_EQ(canopen.read(0x6084 + 0x800), 3333);
-    EXPECT_EQ(canopen.read(0x2003 + 0x200), 200);
-    EXPECT_EQ(canopen.read(0x2000 + 0x200), 6);
-    EXPECT_EQ(canopen.read(0x2017 + 0x200), 40000);
-    EXPECT_EQ(canopen.read(0x2015 + 0x400), 77);
-    EXPECT_EQ(canopen.read(0x2005 + 0x200), 0b0110) << "right disabled, left inverted";
-    EXPECT_EQ(canopen.read(0x6081), 51200) << "only stored values survive";
-    EXPECT_EQ(canopen.read(0x2001 + 0x200), 200) << "not shared: the default";
-    EXPECT_EQ(canopen.read(0x2003), 128);
+    expect_taken_over(log, kTakeOverToCanopen, dir);
+    expect_objects(canopen, {{0x6881, 12345}, {0x6883, 2222}, {0x6884, 3333}, {0x2203, 200}, {0x2200, 6},
+                             {0x2217, 40000}, {0x2415, 77},
+                             {0x2205, 0b0110},   // right disabled, left inverted
+                             {0x6081, 51200},    // only stored values survive
+                             {0x2201, 200},      // not shared: the default
+                             {0x2003, 128}});
   }
   {
     std::vector<std::string> log;
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
     EXPECT_TRUE(log.empty()) << "the new image is the CANopen firmware's own: " << log[0];
-    EXPECT_EQ(canopen.read(0x6081 + 0x800), 12345) << "stored by the change";
+    EXPECT_EQ(canopen.read(0x6881), 12345) << "stored by the change";
   }
   {
     std::vector<std::string> log;
     Tmcl tmcl = open_tmcl(dir.path(), log);
     ASSERT_NE(tmcl.module, nullptr);
-    EXPECT_EQ(lines_with(log, kTakeOverToTmcl), 1u);
-    EXPECT_EQ(log.size(), 1u);
-    EXPECT_EQ(tmcl.gap(4, 1), 12345);
-    EXPECT_EQ(tmcl.gap(35, 1), 40000);
-    EXPECT_EQ(tmcl.gap(12, 1), 1);
-    EXPECT_EQ(tmcl.gap(13, 1), 0);
-    EXPECT_EQ(tmcl.gap(25, 1), 1);
-    EXPECT_EQ(tmcl.gap(21, 2), 77);
-    EXPECT_EQ(tmcl.gap(37, 1), 0) << "the CANopen firmware has no place for it";
+    expect_taken_over(log, kTakeOverToTmcl, dir);
+    expect_aps(tmcl, {{4, 1, 12345}, {35, 1, 40000}, {12, 1, 1}, {13, 1, 0}, {25, 1, 1}, {21, 2, 77},
+                      {37, 1, 0}});  // AP 37: the CANopen firmware has no place for it
   }
-  EXPECT_FALSE(damaged_exists(dir));
 }
 
 TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_back) {
   testing::ScratchDirectory dir;
+  // 208C = 0: v = v_reg x fCLK / 2^24, a = a_reg x fCLK² / 2^41 (fCLK 12 MHz).
+  const int64_t chip_velocity_1000 = std::lround(1000 * 12e6 / 16777216.0);
+  const int64_t chip_acceleration_1000 = std::lround(1000 * 12e6 * 12e6 / 2199023255552.0);
   {
     std::vector<std::string> log;
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
-    canopen.write(0x6081 + 0x1000, 30000);        // axis 2
-    canopen.write(0x6082 + 0x1000, 10);
-    canopen.write(0x2004 + 0x400, 20);
-    canopen.write(0x2005 + 0x400, 1 | 8 | 16);    // left disabled, right inverted, home disabled
-    canopen.write(0x2089 + 0x400, 50);            // setting delay: no TMCL parameter
+    // Axis 2: 6081, 6082, 2004, 2005 left disabled + right inverted + home disabled, 2089 (the
+    // setting delay, no TMCL parameter).
+    for (const ObjectValue& write : {ObjectValue{0x7081, 30000}, {0x7082, 10}, {0x2404, 20}, {0x2405, 1 | 8 | 16},
+                                     {0x2489, 50}}) {
+      canopen.write(write.index, write.value);
+    }
     canopen.store_motor(2);
-    canopen.write(0x208C, 0);                     // axis 0 in the chip's units
-    canopen.write(0x6081, 1000);
-    canopen.write(0x6083, 1000);
+    for (const ObjectValue& write : {ObjectValue{0x208C, 0}, {0x6081, 1000}, {0x6083, 1000}}) {  // chip units
+      canopen.write(write.index, write.value);
+    }
     canopen.store_motor(0);
   }
   {
     std::vector<std::string> log;
     Tmcl tmcl = open_tmcl(dir.path(), log);
     ASSERT_NE(tmcl.module, nullptr);
-    EXPECT_EQ(log.size(), 1u);
-    EXPECT_EQ(lines_with(log, kTakeOverToTmcl), 1u) << (log.empty() ? "" : log[0]);
-    EXPECT_FALSE(damaged_exists(dir));
-    EXPECT_EQ(tmcl.gap(4, 2), 30000);
-    EXPECT_EQ(tmcl.gap(20, 2), 10);
-    EXPECT_EQ(tmcl.gap(7, 2), 20);
-    EXPECT_EQ(tmcl.gap(13, 2), 1);
-    EXPECT_EQ(tmcl.gap(12, 2), 0);
-    EXPECT_EQ(tmcl.gap(24, 2), 1);
-    EXPECT_EQ(tmcl.gap(25, 2), 0);
-    EXPECT_EQ(tmcl.gap(14, 2), 0) << "not shared: the default";
-    EXPECT_EQ(tmcl.gap(4, 1), 51200);
-    // 208C = 0: v = v_reg x fCLK / 2^24, a = a_reg x fCLK² / 2^41 (fCLK 12 MHz).
-    EXPECT_EQ(tmcl.gap(4, 0), std::lround(1000 * 12e6 / 16777216.0));
-    EXPECT_EQ(tmcl.gap(5, 0), std::lround(1000 * 12e6 * 12e6 / 2199023255552.0));
+    expect_taken_over(log, kTakeOverToTmcl, dir);
+    expect_aps(tmcl, {{4, 2, 30000}, {20, 2, 10}, {7, 2, 20}, {13, 2, 1}, {12, 2, 0}, {24, 2, 1}, {25, 2, 0},
+                      {14, 2, 0},  // not shared: the default
+                      {4, 1, 51200}, {4, 0, chip_velocity_1000}, {5, 0, chip_acceleration_1000}});
   }
   {
     std::vector<std::string> log;
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
-    EXPECT_EQ(lines_with(log, kTakeOverToCanopen), 1u);
-    EXPECT_EQ(canopen.read(0x6081 + 0x1000), 30000);
-    EXPECT_EQ(canopen.read(0x2005 + 0x400), 1 | 8) << "the home bits have no TMCL parameter";
-    EXPECT_EQ(canopen.read(0x2089 + 0x400), 200) << "not shared: the default";
-    EXPECT_EQ(canopen.read(0x208C), 181) << "the TMCL firmware's units";
-    EXPECT_EQ(canopen.read(0x6081), std::lround(1000 * 12e6 / 16777216.0));
+    expect_taken_over(log, kTakeOverToCanopen, dir);
+    expect_objects(canopen, {{0x7081, 30000},
+                             {0x2405, 1 | 8},  // the home bits have no TMCL parameter
+                             {0x2489, 200},    // not shared: the default
+                             {0x208C, 181},    // the TMCL firmware's units
+                             {0x6081, chip_velocity_1000}});
   }
-  EXPECT_FALSE(damaged_exists(dir));
 }
 
 TEST(Tmcm3216FirmwareChange, a_damaged_image_of_the_other_firmware_is_still_set_aside) {

@@ -14,10 +14,7 @@
 namespace motwin::host {
 namespace {
 
-using modules::tmcm3216::kAxisCount;
-using modules::tmcm3216::kSharedAxisSettings;
-using modules::tmcm3216::Tmcm3216;
-using modules::tmcm3216::Tmcm3216Tmcl;
+using namespace modules::tmcm3216;  // the two firmwares, their axis count and shared settings
 
 constexpr size_t kTmclImageSize = Tmcm3216Tmcl::kNvmLayout.total_size;
 constexpr size_t kCanopenImageSize = Tmcm3216::kNvmSize;
