@@ -9,11 +9,14 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
 
+#include "board/ram_non_volatile_memory.h"
 #include "core/canopen/object_dictionary.h"
 #include "core/cia402/profile_objects.h"
 #include "core/params/shared_setting.h"
@@ -37,6 +40,26 @@ class SharedSettingValues {
   std::span<const params::SharedAxisSetting> rows_;
   uint8_t axis_count_;
   std::vector<std::optional<int64_t>> values_;
+};
+
+// A firmware powered up on a copy of an image in memory (kSize bytes): `Device` made by
+// `make(nvm, peripherals)` on default-constructed `Peripherals` (the board seams, a CAN controller
+// that sends nowhere), then power_up(), so that it holds what the image stores.
+template <class Device, size_t kSize, class Peripherals>
+struct FirmwareOnImage {
+  template <class Make>
+  FirmwareOnImage(const uint8_t* bytes, const Make& make)
+      : nvm(std::make_unique<board::RamNonVolatileMemory<kSize>>()), peripherals(std::make_unique<Peripherals>()) {
+    std::memcpy(nvm->mutable_data(), bytes, kSize);
+    device = make(*nvm, *peripherals);
+    device->power_up();
+  }
+  // The image as the firmware left it.
+  void copy_image(uint8_t* out) const { std::memcpy(out, nvm->data(), kSize); }
+
+  std::unique_ptr<board::RamNonVolatileMemory<kSize>> nvm;
+  std::unique_ptr<Peripherals> peripherals;
+  std::unique_ptr<Device> device;
 };
 
 // The units of a CANopen axis' velocity and acceleration objects (the TMCM-3216: 208C).

@@ -1,9 +1,5 @@
 #include "host/modules/tmcm3216/tmcm3216_firmware_change.h"
 
-#include <cstring>
-#include <memory>
-
-#include "board/ram_non_volatile_memory.h"
 #include "core/modules/tmcm3216/tmcm3216.h"
 #include "core/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "core/modules/tmcm3216/tmcm3216_tmcl.h"
@@ -18,8 +14,6 @@ using namespace modules::tmcm3216;  // the two firmwares, their axis count and s
 
 constexpr size_t kTmclImageSize = Tmcm3216Tmcl::kNvmLayout.total_size;
 constexpr size_t kCanopenImageSize = Tmcm3216::kNvmSize;
-using TmclImage = board::RamNonVolatileMemory<kTmclImageSize>;
-using CanopenImage = board::RamNonVolatileMemory<kCanopenImageSize>;
 
 // 1010 sub 4 + n: save motor n's parameters.
 constexpr uint8_t kSaveMotorSubIndex = 4;
@@ -34,34 +28,27 @@ bool is_canopen_image(const PreviousFirmwareImage& previous) {
          previous.payload.size() == kCanopenImageSize;
 }
 
-// The CANopen firmware on a copy of `bytes`, powered up (every object from the image).
-struct CanopenFirmware {
-  explicit CanopenFirmware(const uint8_t* bytes) : nvm(std::make_unique<CanopenImage>()) {
-    std::memcpy(nvm->mutable_data(), bytes, kCanopenImageSize);
-    device = make_unique_zeroed<Tmcm3216>(*nvm, can, board);
-    device->power_up();
-  }
+struct CanopenPeripherals {
+  NullCanController can;
+  board::Tmcm3216Board board{};
+};
+
+// The CANopen firmware on a copy of `bytes`, with the units of its axes.
+struct CanopenFirmware : FirmwareOnImage<Tmcm3216, kCanopenImageSize, CanopenPeripherals> {
+  explicit CanopenFirmware(const uint8_t* bytes)
+      : FirmwareOnImage(bytes, [](board::NonVolatileMemory& memory, CanopenPeripherals& p) {
+          return make_unique_zeroed<Tmcm3216>(memory, p.can, p.board);
+        }) {}
   CanopenAxisUnits units() {
     return [this](uint8_t axis) { return device->drive(axis).units(); };
   }
-
-  std::unique_ptr<CanopenImage> nvm;
-  NullCanController can;
-  board::Tmcm3216Board board{};
-  std::unique_ptr<Tmcm3216> device;
 };
 
-// The TMCL firmware on a copy of `bytes`, powered up (every stored parameter from the image).
-struct TmclFirmware {
-  explicit TmclFirmware(const uint8_t* bytes) : nvm(std::make_unique<TmclImage>()) {
-    std::memcpy(nvm->mutable_data(), bytes, kTmclImageSize);
-    device = make_unique_zeroed<Tmcm3216Tmcl>(*nvm, board);
-    device->power_up();
-  }
-
-  std::unique_ptr<TmclImage> nvm;
-  board::Tmcm3216Board board{};
-  std::unique_ptr<Tmcm3216Tmcl> device;
+struct TmclFirmware : FirmwareOnImage<Tmcm3216Tmcl, kTmclImageSize, board::Tmcm3216Board> {
+  explicit TmclFirmware(const uint8_t* bytes)
+      : FirmwareOnImage(bytes, [](board::NonVolatileMemory& memory, board::Tmcm3216Board& board) {
+          return make_unique_zeroed<Tmcm3216Tmcl>(memory, board);
+        }) {}
 };
 
 }  // namespace
@@ -77,7 +64,7 @@ bool tmcm3216_canopen_image_from_tmcl(const PreviousFirmwareImage& previous, uin
         canopen.device->store_parameters(static_cast<uint8_t>(kSaveMotorSubIndex + axis), Tmcm3216::kSaveSignature);
     if (saved != canopen::SdoAbort::kNone) return false;
   }
-  std::memcpy(image, canopen.nvm->data(), size);
+  canopen.copy_image(image);
   return true;
 }
 
@@ -89,7 +76,7 @@ bool tmcm3216_tmcl_image_from_canopen(const PreviousFirmwareImage& previous, uin
   TmclFirmware tmcl(image);
   write_tmcl_settings(*tmcl.device, values);
   if (tmcl.device->last_store_failed()) return false;
-  std::memcpy(image, tmcl.nvm->data(), size);
+  tmcl.copy_image(image);
   return true;
 }
 
