@@ -19,6 +19,7 @@
 #include "host/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "host/modules/tmcm3216/tmcm3216_tmcl_virtual_module.h"
 #include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
+#include "support/firmware_change_support.h"
 #include "support/host_test_support.h"
 
 namespace motwin::host {
@@ -30,102 +31,31 @@ using modules::tmcm3216::Tmcm3216Tmcl;
 constexpr const char* kTakeOverToCanopen = "was written by firmware 3216V100; CANopen V1.04 takes it over like a firmware update";
 constexpr const char* kTakeOverToTmcl = "was written by firmware CANopen V1.04; 3216V100 takes it over like a firmware update";
 
-ModuleOptions options_in(const std::filesystem::path& dir, std::vector<std::string>& log) {
-  ModuleOptions options;
-  options.state_dir = dir;
-  options.log = [&log](const std::string& line) { log.push_back(line); };
-  return options;
-}
-
-struct Canopen {
-  std::unique_ptr<VirtualModule> module;
-  Tmcm3216& device() { return static_cast<Tmcm3216VirtualModule&>(*module).device(); }
-  int64_t read(uint16_t index, uint8_t sub = 0) {
-    canopen::ObjectRef ref;
-    EXPECT_EQ(device().dictionary().find(index, sub, ref), canopen::SdoAbort::kNone) << std::hex << index;
-    return device().dictionary().value(ref);
-  }
-  void write(uint16_t index, int64_t value, uint8_t sub = 0) {
-    canopen::ObjectRef ref;
-    ASSERT_EQ(device().dictionary().find(index, sub, ref), canopen::SdoAbort::kNone) << std::hex << index;
-    uint8_t bytes[8] = {};
-    canopen::encode_value(ref.info->type, value, bytes);
-    ASSERT_EQ(device().dictionary().write(ref, bytes, canopen::type_size(ref.info->type)), canopen::SdoAbort::kNone)
-        << std::hex << index;
-  }
-  void store_motor(uint8_t axis) {
-    ASSERT_EQ(device().store_parameters(static_cast<uint8_t>(4 + axis), Tmcm3216::kSaveSignature),
-              canopen::SdoAbort::kNone);
-  }
-};
-
-struct Tmcl {
-  std::unique_ptr<VirtualModule> module;
-  Tmcm3216Tmcl& device() { return static_cast<Tmcm3216TmclVirtualModule&>(*module).device(); }
-  int32_t gap(uint8_t number, uint8_t motor) {
-    int32_t value = 0;
-    EXPECT_EQ(device().get_axis_parameter(number, motor, value), tmcl::Status::kOk) << "AP " << int{number};
-    return value;
-  }
-  void sap_stap(uint8_t number, uint8_t motor, int32_t value) {
-    ASSERT_EQ(device().set_axis_parameter(number, motor, value), tmcl::Status::kOk) << "AP " << int{number};
-    ASSERT_EQ(device().store_axis_parameter(number, motor), tmcl::Status::kOk) << "AP " << int{number};
-  }
-};
+using Canopen = testing::CanopenOn<Tmcm3216VirtualModule>;
+using Tmcl = testing::TmclOn<Tmcm3216TmclVirtualModule>;
+using testing::ApValue;
+using testing::ObjectValue;
 
 Canopen open_canopen(const std::filesystem::path& dir, std::vector<std::string>& log) {
-  MakeModuleResult made = Tmcm3216VirtualModule::make(options_in(dir, log));
-  EXPECT_TRUE(made) << (made ? "" : made.error());
-  return Canopen{made ? std::move(*made) : nullptr};
+  return testing::open_on<Canopen>(&Tmcm3216VirtualModule::make, dir, log);
 }
 
 Tmcl open_tmcl(const std::filesystem::path& dir, std::vector<std::string>& log) {
-  MakeModuleResult made = Tmcm3216TmclVirtualModule::make(options_in(dir, log));
-  EXPECT_TRUE(made) << (made ? "" : made.error());
-  return Tmcl{made ? std::move(*made) : nullptr};
-}
-
-size_t lines_with(const std::vector<std::string>& log, const std::string& text) {
-  size_t count = 0;
-  for (const std::string& line : log) count += line.find(text) != std::string::npos ? 1 : 0;
-  return count;
+  return testing::open_on<Tmcl>(&Tmcm3216TmclVirtualModule::make, dir, log);
 }
 
 std::filesystem::path image_in(const testing::ScratchDirectory& dir) {
   return EepromFile::image_path(dir.path(), Tmcm3216::kName);
 }
 
-bool damaged_exists(const testing::ScratchDirectory& dir) {
-  return std::filesystem::exists(image_in(dir).string() + ".damaged");
-}
+bool damaged_exists(const testing::ScratchDirectory& dir) { return testing::damaged_exists(dir, Tmcm3216::kName); }
 
-// An AP of a motor, or a CANopen object (at its axis' index), with a value.
-struct ApValue {
-  uint8_t number;
-  uint8_t motor;
-  int64_t value;
-};
-struct ObjectValue {
-  uint16_t index;
-  int64_t value;
-};
-
-void expect_aps(Tmcl& tmcl, std::initializer_list<ApValue> expected) {
-  for (const ApValue& e : expected) {
-    EXPECT_EQ(tmcl.gap(e.number, e.motor), e.value) << "AP " << int{e.number} << " of motor " << int{e.motor};
-  }
-}
-
-void expect_objects(Canopen& canopen, std::initializer_list<ObjectValue> expected) {
-  for (const ObjectValue& e : expected) EXPECT_EQ(canopen.read(e.index), e.value) << std::hex << e.index;
-}
-
-// The one line of a change, and nothing set aside.
 void expect_taken_over(const std::vector<std::string>& log, const char* line, const testing::ScratchDirectory& dir) {
-  EXPECT_EQ(log.size(), 1u);
-  EXPECT_EQ(lines_with(log, line), 1u) << (log.empty() ? "" : log[0]);
-  EXPECT_FALSE(damaged_exists(dir));
+  testing::expect_taken_over(log, line, dir, Tmcm3216::kName);
 }
+
+// 1010 sub 4 + n: motor n's parameters.
+void store_motor(Canopen& canopen, uint8_t axis) { canopen.store(static_cast<uint8_t>(4 + axis)); }
 
 TEST(Tmcm3216FirmwareChange, tmcl_settings_survive_on_the_canopen_firmware_and_back) {
   testing::ScratchDirectory dir;
@@ -135,10 +65,8 @@ TEST(Tmcm3216FirmwareChange, tmcl_settings_survive_on_the_canopen_firmware_and_b
     ASSERT_NE(tmcl.module, nullptr);
     // 6081, 6083, 6084, 2003, 2000, 2017 of axis 1, 2015 of axis 2, 2005 bits 1 and 2 of axis 1;
     // AP 37 has no CANopen object.
-    for (const ApValue& set : {ApValue{4, 1, 12345}, {5, 1, 2222}, {17, 1, 3333}, {6, 1, 200}, {140, 1, 6},
-                               {35, 1, 40000}, {21, 2, 77}, {12, 1, 1}, {25, 1, 1}, {37, 1, 500}}) {
-      tmcl.sap_stap(set.number, set.motor, static_cast<int32_t>(set.value));
-    }
+    testing::sap_stap_all(tmcl, {{4, 1, 12345}, {5, 1, 2222}, {17, 1, 3333}, {6, 1, 200}, {140, 1, 6}, {35, 1, 40000},
+                                 {21, 2, 77}, {12, 1, 1}, {25, 1, 1}, {37, 1, 500}});
     ASSERT_EQ(tmcl.device().set_axis_parameter(4, 0, 777), tmcl::Status::kOk) << "set, never stored";
   }
   {
@@ -146,12 +74,12 @@ TEST(Tmcm3216FirmwareChange, tmcl_settings_survive_on_the_canopen_firmware_and_b
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
     expect_taken_over(log, kTakeOverToCanopen, dir);
-    expect_objects(canopen, {{0x6881, 12345}, {0x6883, 2222}, {0x6884, 3333}, {0x2203, 200}, {0x2200, 6},
-                             {0x2217, 40000}, {0x2415, 77},
-                             {0x2205, 0b0110},   // right disabled, left inverted
-                             {0x6081, 51200},    // only stored values survive
-                             {0x2201, 200},      // not shared: the default
-                             {0x2003, 128}});
+    testing::expect_objects(canopen, {{0x6881, 0, 12345}, {0x6883, 0, 2222}, {0x6884, 0, 3333}, {0x2203, 0, 200}, {0x2200, 0, 6},
+                             {0x2217, 0, 40000}, {0x2415, 0, 77},
+                             {0x2205, 0, 0b0110},   // right disabled, left inverted
+                             {0x6081, 0, 51200},    // only stored values survive
+                             {0x2201, 0, 200},      // not shared: the default
+                             {0x2003, 0, 128}});
   }
   {
     std::vector<std::string> log;
@@ -165,7 +93,7 @@ TEST(Tmcm3216FirmwareChange, tmcl_settings_survive_on_the_canopen_firmware_and_b
     Tmcl tmcl = open_tmcl(dir.path(), log);
     ASSERT_NE(tmcl.module, nullptr);
     expect_taken_over(log, kTakeOverToTmcl, dir);
-    expect_aps(tmcl, {{4, 1, 12345}, {35, 1, 40000}, {12, 1, 1}, {13, 1, 0}, {25, 1, 1}, {21, 2, 77},
+    testing::expect_aps(tmcl, {{4, 1, 12345}, {35, 1, 40000}, {12, 1, 1}, {13, 1, 0}, {25, 1, 1}, {21, 2, 77},
                       {37, 1, 0}});  // AP 37: the CANopen firmware has no place for it
   }
 }
@@ -181,22 +109,18 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     ASSERT_NE(canopen.module, nullptr);
     // Axis 2: 6081, 6082, 2004, 2005 left disabled + right inverted + home disabled, 2089 (the
     // setting delay, no TMCL parameter).
-    for (const ObjectValue& write : {ObjectValue{0x7081, 30000}, {0x7082, 10}, {0x2404, 20}, {0x2405, 1 | 8 | 16},
-                                     {0x2489, 50}}) {
-      canopen.write(write.index, write.value);
-    }
-    canopen.store_motor(2);
-    for (const ObjectValue& write : {ObjectValue{0x208C, 0}, {0x6081, 1000}, {0x6083, 1000}}) {  // chip units
-      canopen.write(write.index, write.value);
-    }
-    canopen.store_motor(0);
+    testing::write_objects(canopen, {{0x7081, 0, 30000}, {0x7082, 0, 10}, {0x2404, 0, 20}, {0x2405, 0, 1 | 8 | 16},
+                                     {0x2489, 0, 50}});
+    store_motor(canopen, 2);
+    testing::write_objects(canopen, {{0x208C, 0, 0}, {0x6081, 0, 1000}, {0x6083, 0, 1000}});  // chip units
+    store_motor(canopen, 0);
   }
   {
     std::vector<std::string> log;
     Tmcl tmcl = open_tmcl(dir.path(), log);
     ASSERT_NE(tmcl.module, nullptr);
     expect_taken_over(log, kTakeOverToTmcl, dir);
-    expect_aps(tmcl, {{4, 2, 30000}, {20, 2, 10}, {7, 2, 20}, {13, 2, 1}, {12, 2, 0}, {24, 2, 1}, {25, 2, 0},
+    testing::expect_aps(tmcl, {{4, 2, 30000}, {20, 2, 10}, {7, 2, 20}, {13, 2, 1}, {12, 2, 0}, {24, 2, 1}, {25, 2, 0},
                       {14, 2, 0},  // not shared: the default
                       {4, 1, 51200}, {4, 0, chip_velocity_1000}, {5, 0, chip_acceleration_1000}});
   }
@@ -205,11 +129,11 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
     expect_taken_over(log, kTakeOverToCanopen, dir);
-    expect_objects(canopen, {{0x7081, 30000},
-                             {0x2405, 1 | 8},  // the home bits have no TMCL parameter
-                             {0x2489, 200},    // not shared: the default
-                             {0x208C, 181},    // the TMCL firmware's units
-                             {0x6081, chip_velocity_1000}});
+    testing::expect_objects(canopen, {{0x7081, 0, 30000},
+                             {0x2405, 0, 1 | 8},  // the home bits have no TMCL parameter
+                             {0x2489, 0, 200},    // not shared: the default
+                             {0x208C, 0, 181},    // the TMCL firmware's units
+                             {0x6081, 0, chip_velocity_1000}});
   }
 }
 
