@@ -81,5 +81,28 @@ def test_tmcl_setting_read_by_the_canopen_firmware(motwin):
         check_nothing_set_aside(state)
 
 
+def test_a_change_killed_while_writing_is_done_again_at_the_next_start(motwin):
+    """The converted image is written atomically: a SIGKILL just before its rename (the crash-point
+    hook, docs/host-runtime.md) leaves the TMCL firmware's image, which the next start converts."""
+    with TempDir() as tmp:
+        state = os.path.join(tmp, "state")
+        with TmclServer(motwin, state) as server, server.tcp() as c:
+            c.sap(MAX_VELOCITY, 56789, motor=1)
+            c.stap(MAX_VELOCITY, motor=1)
+            server.stop()
+        crashing = CanServer(motwin, state, node_id=NODE, env={"MOTWIN_CRASH_AT_PERSIST_STEP": "rename"})
+        try:
+            check_equal(crashing.start_expect_failure(), -9, "serve killed before the rename")
+        finally:
+            crashing.cleanup()
+        with CanServer(motwin, state, node_id=NODE) as server, server.bus() as bus:
+            check_equal(bus.upload_u(NODE, PROFILE_VELOCITY_AXIS1, 0), 56789, "6881 after the change, done again")
+            server.stop()
+            check_one_change_line(server, TO_CANOPEN)
+        check_nothing_set_aside(state)
+        check(not os.path.exists(os.path.join(state, "tmcm-3216.eeprom.tmp")), "the temporary file is gone")
+
+
 if __name__ == "__main__":
-    run_can_tests([test_canopen_setting_read_by_the_tmcl_firmware_and_back, test_tmcl_setting_read_by_the_canopen_firmware])
+    run_can_tests([test_canopen_setting_read_by_the_tmcl_firmware_and_back, test_tmcl_setting_read_by_the_canopen_firmware,
+                   test_a_change_killed_while_writing_is_done_again_at_the_next_start])

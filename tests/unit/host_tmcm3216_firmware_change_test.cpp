@@ -114,6 +114,9 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     store_motor(canopen, 2);
     testing::write_objects(canopen, {{0x208C, 0, 0}, {0x6081, 0, 1000}, {0x6083, 0, 1000}});  // chip units
     store_motor(canopen, 0);
+    // Beyond AP 4's range (6081 takes 32 bits): the TMCL firmware refuses it, AP 4 keeps its default.
+    testing::write_objects(canopen, {{0x6881, 0, 20000000}, {0x6883, 0, 7777}});
+    store_motor(canopen, 1);
   }
   {
     std::vector<std::string> log;
@@ -122,7 +125,8 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     expect_taken_over(log, kTakeOverToTmcl, dir);
     testing::expect_aps(tmcl, {{4, 2, 30000}, {20, 2, 10}, {7, 2, 20}, {13, 2, 1}, {12, 2, 0}, {24, 2, 1}, {25, 2, 0},
                       {14, 2, 0},  // not shared: the default
-                      {4, 1, 51200}, {4, 0, chip_velocity_1000}, {5, 0, chip_acceleration_1000}});
+                      {4, 1, 51200},  // refused: the default
+                      {5, 1, 7777}, {4, 0, chip_velocity_1000}, {5, 0, chip_acceleration_1000}});
   }
   {
     std::vector<std::string> log;
