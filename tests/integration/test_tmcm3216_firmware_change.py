@@ -43,6 +43,25 @@ def check_nothing_set_aside(state_dir):
     check_equal(left, [], "files set aside as damaged")
 
 
+def store_under_tmcl(motwin, state, max_velocity):
+    """AP 4 of motor 1 set and stored (STAP) under the TMCL firmware, on a fresh image."""
+    with TmclServer(motwin, state) as server, server.tcp() as c:
+        c.sap(MAX_VELOCITY, max_velocity, motor=1)
+        c.stap(MAX_VELOCITY, motor=1)
+        server.stop()
+        check(not any("takes it over" in line for line in server.stderr_lines()), "a fresh image: no change")
+
+
+def check_canopen_took_over(motwin, state, max_velocity, what, more=lambda bus: None):
+    """6881 under the CANopen firmware is `max_velocity`; one change line; nothing set aside."""
+    with CanServer(motwin, state, node_id=NODE) as server, server.bus() as bus:
+        check_equal(bus.upload_u(NODE, PROFILE_VELOCITY_AXIS1, 0), max_velocity, what)
+        more(bus)
+        server.stop()
+        check_one_change_line(server, TO_CANOPEN)
+    check_nothing_set_aside(state)
+
+
 def test_canopen_setting_read_by_the_tmcl_firmware_and_back(motwin):
     with TempDir() as tmp:
         state = os.path.join(tmp, "state")
@@ -58,27 +77,15 @@ def test_canopen_setting_read_by_the_tmcl_firmware_and_back(motwin):
             server.stop()
             check_one_change_line(server, TO_TMCL)
         check_nothing_set_aside(state)
-        with CanServer(motwin, state, node_id=NODE) as server, server.bus() as bus:
-            check_equal(bus.upload_u(NODE, PROFILE_VELOCITY_AXIS1, 0), 34567, "6881 after the change back")
-            server.stop()
-            check_one_change_line(server, TO_CANOPEN)
-        check_nothing_set_aside(state)
+        check_canopen_took_over(motwin, state, 34567, "6881 after the change back")
 
 
 def test_tmcl_setting_read_by_the_canopen_firmware(motwin):
     with TempDir() as tmp:
         state = os.path.join(tmp, "state")
-        with TmclServer(motwin, state) as server, server.tcp() as c:
-            c.sap(MAX_VELOCITY, 45678, motor=1)
-            c.stap(MAX_VELOCITY, motor=1)
-            server.stop()
-            check(not any("takes it over" in line for line in server.stderr_lines()), "a fresh image: no change")
-        with CanServer(motwin, state, node_id=NODE) as server, server.bus() as bus:
-            check_equal(bus.upload_u(NODE, PROFILE_VELOCITY_AXIS1, 0), 45678, "6881 after the change to CANopen")
-            check_equal(bus.upload_u(NODE, 0x6081, 0), 51200, "6081 of axis 0: the default")
-            server.stop()
-            check_one_change_line(server, TO_CANOPEN)
-        check_nothing_set_aside(state)
+        store_under_tmcl(motwin, state, 45678)
+        check_canopen_took_over(motwin, state, 45678, "6881 after the change to CANopen",
+                                lambda bus: check_equal(bus.upload_u(NODE, 0x6081, 0), 51200, "6081 of axis 0: the default"))
 
 
 def test_a_change_killed_while_writing_is_done_again_at_the_next_start(motwin):
@@ -86,20 +93,13 @@ def test_a_change_killed_while_writing_is_done_again_at_the_next_start(motwin):
     hook, docs/host-runtime.md) leaves the TMCL firmware's image, which the next start converts."""
     with TempDir() as tmp:
         state = os.path.join(tmp, "state")
-        with TmclServer(motwin, state) as server, server.tcp() as c:
-            c.sap(MAX_VELOCITY, 56789, motor=1)
-            c.stap(MAX_VELOCITY, motor=1)
-            server.stop()
+        store_under_tmcl(motwin, state, 56789)
         crashing = CanServer(motwin, state, node_id=NODE, env={"MOTWIN_CRASH_AT_PERSIST_STEP": "rename"})
         try:
             check_equal(crashing.start_expect_failure(), -9, "serve killed before the rename")
         finally:
             crashing.cleanup()
-        with CanServer(motwin, state, node_id=NODE) as server, server.bus() as bus:
-            check_equal(bus.upload_u(NODE, PROFILE_VELOCITY_AXIS1, 0), 56789, "6881 after the change, done again")
-            server.stop()
-            check_one_change_line(server, TO_CANOPEN)
-        check_nothing_set_aside(state)
+        check_canopen_took_over(motwin, state, 56789, "6881 after the change, done again")
         check(not os.path.exists(os.path.join(state, "tmcm-3216.eeprom.tmp")), "the temporary file is gone")
 
 
