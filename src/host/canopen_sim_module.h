@@ -122,16 +122,18 @@ class CanopenSimModule final : public VirtualModule, public CanBusNode, private 
   // board, config)` (a std::unique_ptr<Device>) and powers it up. Switched on before any bus is
   // connected and before `ready`: its restart time passes (the services only: nothing moves
   // before the boot-up) and its boot-up reaches nobody, as on a real bus that a master joins
-  // later. Masters send an NMT reset to see one (docs/canopen.md "Start-up timing").
+  // later. Masters send an NMT reset to see one (docs/canopen.md "Start-up timing"). `take_over`:
+  // what the module does with another firmware's image in that firmware's layout (ModuleEeprom::open).
   template <class BuildBoard, class BuildDevice>
   static MakeModuleResult power_up_on_bus(const ModuleOptions& options, const BuildBoard& build_board,
                                           const BuildDevice& build_device,
-                                          const FactoryImageFormatter& format_image = &Device::format_factory_image) {
+                                          const FactoryImageFormatter& format_image = &Device::format_factory_image,
+                                          const FirmwareTakeOver& take_over = {}) {
     const Result<canopen::NodeConfig> config =
         canopen_node_config(options, Device::kBootDelayUs, Device::kCommunicationBootDelayUs);
     if (!config) return Error{config.error()};
     std::unique_ptr<CanopenSimModule> module(new CanopenSimModule());
-    const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), format_image);
+    const Result<void> eeprom = module->eeprom_.open(options, eeprom_identity(), format_image, {}, take_over);
     if (!eeprom) return Error{eeprom.error()};
     if constexpr (std::is_void_v<SimIo>) {
       module->board_ = build_board();

@@ -199,17 +199,22 @@ Result<std::unique_ptr<EepromFile>> EepromFile::open(const std::filesystem::path
   ::unlink(file->temporary_path_.c_str());
 
   std::vector<uint8_t> bytes;
+  std::string other_firmware_damage;
   const int read_error = read_file(path, bytes);
   if (read_error == ENOENT) {
     file->load_outcome_ = EepromLoadOutcome::kCreated;
   } else if (read_error != 0) {
     return Error{"cannot read EEPROM image " + path.string() + ": " + errno_text(read_error)};
+  } else if (file->take_over_other_firmware(bytes, format_factory_image, other_firmware_damage)) {
+    return file;
   } else if (std::optional<Result<void>> migrated = file->migrate_older_layout(bytes); migrated) {
     if (!*migrated) return Error{migrated->error()};
     return file;
   } else if (const Result<void> valid = validate(identity, bytes); !valid) {
     file->load_outcome_ = EepromLoadOutcome::kReplacedDamaged;
-    log("motwin: EEPROM image " + path.string() + " is damaged (" + valid.error() + "); using factory defaults");
+    // Another firmware's image that is damaged in its own layout: that is the reason to give.
+    const std::string reason = other_firmware_damage.empty() ? valid.error() : other_firmware_damage;
+    log("motwin: EEPROM image " + path.string() + " is damaged (" + reason + "); using factory defaults");
     // Keep the evidence; if even that fails the damaged file is simply overwritten below.
     const std::string damaged_path = path.string() + ".damaged";
     (void)::rename(path.c_str(), damaged_path.c_str());
@@ -263,6 +268,33 @@ std::optional<Result<void>> EepromFile::migrate_older_layout(const std::vector<u
     return Result<void>{Error{"cannot write EEPROM image " + path_.string() + ": " + errno_text(error)}};
   }
   return Result<void>{};
+}
+
+// An intact image that another firmware of the module wrote in its own layout, which the running
+// firmware takes over (identity.take_over_firmware): image_ is its conversion, recorded_firmware_
+// the previous firmware, nothing is written yet. False when this does not apply (no hook, the
+// file records no other firmware, is not intact in its own header's layout, or the hook refuses
+// it: a generation of the running firmware in its own layout is ModuleEeprom's firmware_update):
+// the caller goes on as before. `damage`: why a file that records another firmware is not intact.
+bool EepromFile::take_over_other_firmware(const std::vector<uint8_t>& bytes,
+                                          const FactoryImageFormatter& format_factory_image, std::string& damage) {
+  if (!identity_.take_over_firmware || bytes.size() < kHeaderSize) return false;
+  const std::string previous = recorded_firmware_of(bytes);
+  if (previous.empty() || previous == identity_.firmware_version) return false;
+  EepromImageIdentity stored_identity = identity_;
+  stored_identity.layout_version = get_u32(&bytes[kLayoutVersionOffset]);
+  stored_identity.payload_size = get_u32(&bytes[kPayloadSizeOffset]);
+  if (const Result<void> intact = validate(stored_identity, bytes); !intact) {
+    damage = intact.error();
+    return false;
+  }
+  format_factory_image(image_.data(), image_.size());
+  const PreviousFirmwareImage image{previous, stored_identity.layout_version,
+                                    std::span<const uint8_t>(bytes).subspan(kHeaderSize)};
+  if (!identity_.take_over_firmware(image, image_.data(), image_.size())) return false;
+  recorded_firmware_ = previous;
+  load_outcome_ = EepromLoadOutcome::kTakenOver;
+  return true;
 }
 
 bool EepromFile::record_running_firmware() {

@@ -23,6 +23,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -36,6 +37,19 @@ namespace motwin::host {
 using LogSink = std::function<void(const std::string& line)>;
 void log_to_stderr(const std::string& line);
 
+// An intact image (header and payload CRCs right) of the same module that another firmware wrote
+// in another layout (docs/host-runtime.md "Changing firmware").
+struct PreviousFirmwareImage {
+  std::string_view firmware;  // the version string the file records
+  uint32_t layout_version;
+  std::span<const uint8_t> payload;
+};
+
+// Fills `image` (`size` bytes, already the running firmware's factory image) with what the
+// previous firmware's image holds that the running one shares; false when it does not know that
+// firmware or layout (the file is then damaged, as any foreign file).
+using FirmwareTakeOver = std::function<bool(const PreviousFirmwareImage& previous, uint8_t* image, size_t size)>;
+
 struct EepromImageIdentity {
   std::string module_name;  // at most EepromFile::kMaxModuleNameLength characters
   uint32_t layout_version;  // bumped by the module whenever its stored layout changes
@@ -48,6 +62,12 @@ struct EepromImageIdentity {
   // in place; false when it cannot. Empty: every other layout version is foreign. A migrated
   // image is rewritten at once with the new layout version (one log line says so).
   std::function<bool(uint32_t stored_layout_version, uint8_t* payload, size_t size)> migrate_layout = {};
+  // Takes over an image that another firmware of the module wrote in its own layout (another
+  // layout version or size), e.g. the TMCM-3216's CANopen image under its TMCL firmware. Empty:
+  // such an image is foreign (damaged). The converted image is not written by open(): the file
+  // still records the previous firmware (recorded_firmware()), and ModuleEeprom::open logs the
+  // change and writes the new image with the running firmware's record.
+  FirmwareTakeOver take_over_firmware = {};
 };
 
 // Fills `image` (payload_size bytes) with the module's factory defaults.
@@ -58,6 +78,7 @@ enum class EepromLoadOutcome : uint8_t {
   kCreated,          // there was no file: the factory image was written
   kReplacedDamaged,  // damaged or foreign: reported, kept as <path>.damaged, factory image written
   kMigrated,         // an older layout version that identity.migrate_layout converted (and wrote)
+  kTakenOver,        // another firmware's layout that identity.take_over_firmware converted (not yet written)
 };
 
 // Steps of an atomic write, in order, for fault injection in tests.
@@ -127,6 +148,8 @@ class EepromFile final : public board::NonVolatileMemory {
  private:
   EepromFile(std::filesystem::path path, EepromImageIdentity identity, int directory_fd, int lock_fd, LogSink log);
   std::optional<Result<void>> migrate_older_layout(const std::vector<uint8_t>& bytes);
+  bool take_over_other_firmware(const std::vector<uint8_t>& bytes, const FactoryImageFormatter& format_factory_image,
+                                std::string& damage);
   // Writes image_ to disk atomically; on failure returns the errno.
   int persist();
   int injected_fault(PersistStep step) const;

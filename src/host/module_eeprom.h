@@ -65,12 +65,17 @@ class ModuleEeprom {
   // Opens (or creates) the file when options.state_dir is set, otherwise formats a memory image.
   // A file that another firmware wrote is updated by `firmware_update` (one log line says so)
   // and then records the running firmware; a file written before the record existed just gets
-  // the record. Fails when the file cannot be used.
+  // the record. A file another firmware wrote in its own layout (another protocol's) is
+  // converted by `take_over` (EepromImageIdentity::take_over_firmware; the same one line) and
+  // written with the running firmware's record. Fails when the file cannot be used.
   Result<void> open(const ModuleOptions& options, const EepromImageIdentity& identity,
-                    const FactoryImageFormatter& format_factory_image, const FirmwareUpdate& firmware_update = {}) {
+                    const FactoryImageFormatter& format_factory_image, const FirmwareUpdate& firmware_update = {},
+                    const FirmwareTakeOver& take_over = {}) {
     if (options.state_dir) {
+      EepromImageIdentity file_identity = identity;
+      if (take_over) file_identity.take_over_firmware = take_over;
       Result<std::unique_ptr<EepromFile>> opened =
-          EepromFile::open(*options.state_dir, identity, format_factory_image, options.log);
+          EepromFile::open(*options.state_dir, file_identity, format_factory_image, options.log);
       if (!opened) return Error{opened.error()};
       file_ = std::move(*opened);
       nvm_ = file_.get();
@@ -78,7 +83,7 @@ class ModuleEeprom {
       if (!previous.empty() && previous != identity.firmware_version) {
         options.log("motwin: EEPROM image " + file_->path().string() + " was written by firmware " + previous +
                     "; " + identity.firmware_version + " takes it over like a firmware update");
-        if (firmware_update) firmware_update(previous, *nvm_);
+        if (firmware_update && file_->load_outcome() != EepromLoadOutcome::kTakenOver) firmware_update(previous, *nvm_);
       }
       // A failed write was logged; the image in memory is intact, the record follows later.
       (void)file_->record_running_firmware();

@@ -74,17 +74,19 @@ class TmclSimModule final : public VirtualModule {
   // one formatted by `format_image`), builds the board on the motor, sets the initial inputs,
   // lets `build_device` construct device_ (and do what the module needs around it), powers the
   // firmware up and adds TMCL over CAN. The module, or the error of an unusable image.
-  // `firmware` is the running generation's version string and `firmware_update` what starting it
-  // on another generation's image does (ModuleEeprom::open).
+  // `firmware` is the running generation's version string, `firmware_update` what starting it
+  // on another generation's image does and `take_over` what it does with another firmware's image
+  // in that firmware's layout (ModuleEeprom::open).
   template <class Motor, class FormatImage, class BuildDevice>
   static MakeModuleResult power_up_on_board(const ModuleOptions& options, const std::optional<Motor>& motor,
                                             const FormatImage& format_image, const BuildDevice& build_device,
                                             std::string_view firmware = Device::kIdentity.version_string,
-                                            const FirmwareUpdate& firmware_update = {}) {
+                                            const FirmwareUpdate& firmware_update = {},
+                                            const FirmwareTakeOver& take_over = {}) {
     return power_up_on_built_board(
         options,
         [&motor](SimIo& io) { return motor ? std::make_unique<SimBoard>(io, *motor) : std::make_unique<SimBoard>(io); },
-        format_image, build_device, firmware, firmware_update);
+        format_image, build_device, firmware, firmware_update, take_over);
   }
 
   // The same with a board `build_board()` makes (`build_board(io)` with a SimIo): a board on
@@ -93,10 +95,11 @@ class TmclSimModule final : public VirtualModule {
   static MakeModuleResult power_up_on_built_board(const ModuleOptions& options, const BuildBoard& build_board,
                                                   const FormatImage& format_image, const BuildDevice& build_device,
                                                   std::string_view firmware = Device::kIdentity.version_string,
-                                                  const FirmwareUpdate& firmware_update = {}) {
+                                                  const FirmwareUpdate& firmware_update = {},
+                                                  const FirmwareTakeOver& take_over = {}) {
     std::unique_ptr<TmclSimModule> module(new TmclSimModule());
     const Result<void> eeprom =
-        module->eeprom_.open(options, eeprom_identity_of<Device>(firmware), format_image, firmware_update);
+        module->eeprom_.open(options, eeprom_identity_of<Device>(firmware), format_image, firmware_update, take_over);
     if (!eeprom) return Error{eeprom.error()};
     if constexpr (std::is_void_v<SimIo>) {
       module->board_ = build_board();

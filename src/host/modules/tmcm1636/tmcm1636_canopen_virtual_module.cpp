@@ -1,5 +1,6 @@
 #include "host/modules/tmcm1636/tmcm1636_canopen_virtual_module.h"
 
+#include "host/modules/tmcm1636/tmcm1636_firmware_change.h"
 #include "host/modules/tmcm1636/tmcm1636_startup_image.h"
 
 namespace motwin::host {
@@ -26,7 +27,7 @@ MakeModuleResult Tmcm1636CanopenVirtualModule::make(const ModuleOptions& options
         if (board::Tmcm1636PowerStage* stage = board.power_stage()) device->axis().attach_power_stage(stage);
         return device;
       },
-      format_image);
+      format_image, &tmcm1636_canopen_image_from_tmcl);  // after either TMCL generation
 }
 
 }  // namespace motwin::host

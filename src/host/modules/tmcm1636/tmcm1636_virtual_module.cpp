@@ -1,5 +1,6 @@
 #include "host/modules/tmcm1636/tmcm1636_virtual_module.h"
 
+#include "host/modules/tmcm1636/tmcm1636_firmware_change.h"
 #include "host/modules/tmcm1636/tmcm1636_startup_image.h"
 
 namespace motwin::host {
@@ -39,8 +40,10 @@ MakeModuleResult Tmcm1636VirtualModule::make(const ModuleOptions& options) {
       return;
     }
   };
+  // The CANopen firmware's image: its shared settings (docs/tmcm-1636-canopen.md "Changing firmware").
   return power_up_on_board(options, motor, format_image, build_device,
-                           Device::identity_of(generation).version_string, firmware_update);
+                           Device::identity_of(generation).version_string, firmware_update,
+                           tmcm1636_tmcl_take_over(generation));
 }
 
 }  // namespace motwin::host

@@ -1,5 +1,6 @@
 #include "host/modules/tmcm3216/tmcm3216_tmcl_virtual_module.h"
 
+#include "host/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "host/tmcl_module_descriptor.h"
 #include "sim/stepper_motor_selection.h"
 
@@ -18,7 +19,8 @@ MakeModuleResult Tmcm3216TmclVirtualModule::make(const ModuleOptions& options) {
         // The firmware powers up seeing the switches and encoders as set.
         module.board_->before_tick();
         module.device_.emplace(module.eeprom_.nvm(), module.board_->board());
-      });
+      },
+      Device::kIdentity.version_string, {}, &tmcm3216_tmcl_image_from_canopen);  // after the CANopen firmware
 }
 
 ModuleDescriptor tmcm3216_tmcl_descriptor() {

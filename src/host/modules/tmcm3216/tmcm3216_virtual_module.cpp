@@ -1,5 +1,6 @@
 #include "host/modules/tmcm3216/tmcm3216_virtual_module.h"
 
+#include "host/modules/tmcm3216/tmcm3216_firmware_change.h"
 #include "host/zeroed_allocation.h"
 #include "sim/stepper_motor_selection.h"
 
@@ -16,7 +17,8 @@ MakeModuleResult Tmcm3216VirtualModule::make(const ModuleOptions& options) {
       [](board::NonVolatileMemory& nvm, board::CanController& controller, sim::Tmcm3216SimBoard& board,
          const canopen::NodeConfig& config) {
         return make_unique_zeroed<Device>(nvm, controller, board.board(), config);
-      });
+      },
+      &Device::format_factory_image, &tmcm3216_canopen_image_from_tmcl);  // after the TMCL firmware
 }
 
 }  // namespace motwin::host
