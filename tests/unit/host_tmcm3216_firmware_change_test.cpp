@@ -108,9 +108,9 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     Canopen canopen = open_canopen(dir.path(), log);
     ASSERT_NE(canopen.module, nullptr);
     // Axis 2: 6081, 6082, 2004, 2005 left disabled + right inverted + home disabled, 2089 (the
-    // setting delay, no TMCL parameter).
+    // setting delay: AP 214), 200A (the enable drive delay, no TMCL parameter).
     testing::write_objects(canopen, {{0x7081, 0, 30000}, {0x7082, 0, 10}, {0x2404, 0, 20}, {0x2405, 0, 1 | 8 | 16},
-                                     {0x2489, 0, 50}});
+                                     {0x2489, 0, 50}, {0x240A, 0, 100}});
     store_motor(canopen, 2);
     testing::write_objects(canopen, {{0x208C, 0, 0}, {0x6081, 0, 1000}, {0x6083, 0, 1000}});  // chip units
     store_motor(canopen, 0);
@@ -124,7 +124,7 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     ASSERT_NE(tmcl.module, nullptr);
     expect_taken_over(log, kTakeOverToTmcl, dir);
     testing::expect_aps(tmcl, {{4, 2, 30000}, {20, 2, 10}, {7, 2, 20}, {13, 2, 1}, {12, 2, 0}, {24, 2, 1}, {25, 2, 0},
-                      {14, 2, 0},  // not shared: the default
+                      {214, 2, 50}, {14, 2, 0},  // not shared: the default
                       {4, 1, 51200},  // refused: the default
                       {5, 1, 7777}, {4, 0, chip_velocity_1000}, {5, 0, chip_acceleration_1000}});
   }
@@ -135,7 +135,8 @@ TEST(Tmcm3216FirmwareChange, canopen_settings_survive_on_the_tmcl_firmware_and_b
     expect_taken_over(log, kTakeOverToCanopen, dir);
     testing::expect_objects(canopen, {{0x7081, 0, 30000},
                              {0x2405, 0, 1 | 8},  // the home bits have no TMCL parameter
-                             {0x2489, 0, 200},    // not shared: the default
+                             {0x2489, 0, 50},
+                             {0x240A, 0, 0},      // not shared: the default
                              {0x208C, 0, 181},    // the TMCL firmware's units
                              {0x6081, 0, chip_velocity_1000}});
   }

@@ -36,6 +36,41 @@ inline constexpr params::SharedAxisSetting kSharedAxisSettings[] = {
     params::bit(13, 0x2005, kManufacturerAxisStride, cia402::switch_parameter::kLeftDisabled),
     params::bit(24, 0x2005, kManufacturerAxisStride, cia402::switch_parameter::kRightInverted),
     params::bit(25, 0x2005, kManufacturerAxisStride, cia402::switch_parameter::kLeftInverted),
+    params::velocity(22, 0x20B6, kManufacturerAxisStride),        // high speed threshold: fullstep threshold speed
+    params::velocity(23, 0x20B3, kManufacturerAxisStride),        // min DcStep speed
+    params::same(27, 0x20B7, kManufacturerAxisStride),            // high speed chopper mode
+    params::same(28, 0x20B8, kManufacturerAxisStride),            // high speed fullstep mode
+    params::same(31, 0x20B9, kManufacturerAxisStride),            // power down ramp
+    params::same(32, 0x20B4, kManufacturerAxisStride),            // DcStep time
+    params::same(33, 0x20B5, kManufacturerAxisStride),            // DcStep StallGuard
+    params::same(162, 0x2092, kManufacturerAxisStride),           // chopper blank time
+    params::same(163, 0x2093, kManufacturerAxisStride),           // constant TOff mode: chopper mode
+    params::same(164, 0x2094, kManufacturerAxisStride),           // disable fast decay comparator
+    params::same(165, 0x2095, kManufacturerAxisStride),           // chopper hysteresis end
+    params::same(166, 0x2096, kManufacturerAxisStride),           // chopper hysteresis start
+    params::same(167, 0x2097, kManufacturerAxisStride),           // TOff: chopper off time
+    params::same(168, 0x2098, kManufacturerAxisStride),           // smartEnergy current minimum
+    params::same(169, 0x2099, kManufacturerAxisStride),           // smartEnergy current down step
+    params::same(170, 0x209A, kManufacturerAxisStride),           // smartEnergy hysteresis
+    params::same(171, 0x209B, kManufacturerAxisStride),           // smartEnergy current up step
+    params::same(172, 0x209C, kManufacturerAxisStride),           // smartEnergy hysteresis start
+    params::same(173, 0x209D, kManufacturerAxisStride),           // StallGuard2 filter enable
+    params::same(174, 0x209E, kManufacturerAxisStride),           // StallGuard2 threshold
+    params::same(178, 0x20A2, kManufacturerAxisStride),           // global current scaler
+    params::same(179, 0x20A3, kManufacturerAxisStride),           // full scale current range
+    params::velocity(181, 0x20A4, kManufacturerAxisStride),       // stop on stall
+    params::velocity(182, 0x20A5, kManufacturerAxisStride),       // smartEnergy threshold speed
+    params::velocity(186, 0x20B0, kManufacturerAxisStride),       // PWM threshold speed
+    params::same(187, 0x20B1, kManufacturerAxisStride),           // PWM gradient
+    params::same(188, 0x20B2, kManufacturerAxisStride),           // PWM amplitude
+    params::velocity(194, 0x6099, kProfileAxisStride, 1),         // reference search speed: homing speed fast
+    params::velocity(195, 0x6099, kProfileAxisStride, 2),         // reference switch speed: homing speed slow
+    params::same(202, 0x2001, kManufacturerAxisStride),           // fullstep resolution
+    params::same(210, 0x608F, kProfileAxisStride, 1),             // encoder resolution: encoder increments
+    params::same(214, 0x2089, kManufacturerAxisStride),           // power down delay: setting delay
+    params::same(221, 0x20A8, kManufacturerAxisStride),           // StallGuard4 threshold
+    params::same(222, 0x20A9, kManufacturerAxisStride),           // StallGuard4 filter enable
+    params::same(223, 0x20AA, kManufacturerAxisStride),           // StallGuard4 angle offset
     // clang-format on
 };
 
