@@ -3,8 +3,8 @@
 //
 // Output contract (stdout, one line each, flushed):
 //   motwin: tmcm-1636 (1636V109) eeprom <path|none>
-//   endpoint tmcl-tcp 127.0.0.1:<port>            one per --tmcl-tcp
-//   endpoint tmcl-pty <LINK> </dev/pts/N>         for --tmcl-pty
+//   endpoint tmcl-tcp 127.0.0.1:<port>[ echo]     one per --tmcl-tcp (echo: given ,echo)
+//   endpoint tmcl-pty <LINK> </dev/pts/N>[ echo]  for --tmcl-pty
 //   endpoint can-socketcand 127.0.0.1:<port>      one per --can socketcand:... (CANopen modules)
 //   endpoint can-slcan-tcp 127.0.0.1:<port>       one per --can slcan-tcp:...
 //   endpoint can-slcan-pty <LINK> </dev/pts/N>     one per --can slcan:LINK
@@ -49,6 +49,7 @@
 #include "host/socketcand_server.h"
 #include "host/state_dir.h"
 #include "host/tcp_server.h"
+#include "host/tmcl_endpoint_options.h"
 #include "host/web/web_server.h"
 #include "sim/scenario.h"
 #include "sim/signals.h"
@@ -163,10 +164,17 @@ struct ModulePlan {
   std::optional<std::vector<sim::ScenarioEvent>> scenario;
 };
 
+// TMCL over TCP on one address, with or without the transceiver's echo.
+struct TmclTcpPlan {
+  host::TcpEndpointSpec spec;
+  host::LineEcho echo = host::LineEcho::kNone;
+};
+
 // Where it is served.
 struct EndpointPlan {
-  std::vector<host::TcpEndpointSpec> tmcl_tcp;
+  std::vector<TmclTcpPlan> tmcl_tcp;
   std::string tmcl_pty_link;
+  host::LineEcho tmcl_pty_echo = host::LineEcho::kNone;
   std::vector<host::CanEndpointSpec> can;
   uint32_t can_bit_rate = 0;
   std::string can_capture;  // a file; empty: none
@@ -277,13 +285,22 @@ Result<void> check_offered(const host::ModuleDescriptor& module, const EndpointP
 
 Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, const ModulePlan& module) {
   EndpointPlan plan;
-  Result<std::vector<host::TcpEndpointSpec>> tcp =
-      parse_each<host::TcpEndpointSpec>(arguments.tcp_endpoints, [](const std::string& text, size_t) {
-        return with_context(host::parse_tcp_endpoint(text), "--tmcl-tcp: ");
+  Result<std::vector<TmclTcpPlan>> tcp =
+      parse_each<TmclTcpPlan>(arguments.tcp_endpoints, [](const std::string& text, size_t) -> Result<TmclTcpPlan> {
+        const Result<host::TmclEndpointArgument> argument = host::parse_tmcl_endpoint_argument(text);
+        if (!argument) return argument.error_with_context("--tmcl-tcp: ");
+        const Result<host::TcpEndpointSpec> spec = host::parse_tcp_endpoint(argument->address);
+        if (!spec) return spec.error_with_context("--tmcl-tcp: ");
+        return TmclTcpPlan{*spec, argument->echo};
       });
   if (!tcp) return Error{tcp.error()};
   plan.tmcl_tcp = std::move(*tcp);
-  plan.tmcl_pty_link = arguments.pty_link;
+  if (!arguments.pty_link.empty()) {
+    const Result<host::TmclEndpointArgument> pty = host::parse_tmcl_endpoint_argument(arguments.pty_link);
+    if (!pty) return pty.error_with_context("--tmcl-pty: ");
+    plan.tmcl_pty_link = pty->address;
+    plan.tmcl_pty_echo = pty->echo;
+  }
   Result<std::vector<host::CanEndpointSpec>> can =
       parse_each<host::CanEndpointSpec>(arguments.can_endpoints, [](const std::string& text, size_t) {
         return with_context(host::parse_can_endpoint(text), "--can: ");
@@ -293,7 +310,7 @@ Result<EndpointPlan> check_endpoint_arguments(const ServeArguments& arguments, c
   if (plan.tmcl_tcp.empty() && plan.tmcl_pty_link.empty() && plan.can.empty()) {
     // Nodes are on the bus; a single module where its descriptor puts it.
     if (module.nodes.empty() && module.descriptor.endpoints.default_endpoint == host::DefaultEndpoint::kTmclTcp) {
-      plan.tmcl_tcp.push_back(host::TcpEndpointSpec{});  // 127.0.0.1:5000
+      plan.tmcl_tcp.push_back(TmclTcpPlan{});  // 127.0.0.1:5000
     } else {
       plan.can.push_back(host::CanEndpointSpec{});  // socketcand 127.0.0.1:29536
     }
@@ -420,13 +437,18 @@ struct OpenEndpoint {
   std::string line;
 };
 
-// Each kind of endpoint says where it is: an address, or a link and its device.
-std::string where(const host::TmclTcpServer& server) { return server.local_address(); }
+// Each kind of endpoint says where it is: an address, or a link and its device; a TMCL endpoint
+// then its options.
+std::string where(const host::TmclTcpServer& server) {
+  return server.local_address() + host::describe_line_echo(server.echo());
+}
 std::string where(const host::SocketcandServer& server) { return server.local_address(); }
 std::string where(const host::SlcanTcpServer& server) { return server.local_address(); }
 std::string where(const host::SocketcanEndpoint& can) { return can.interface_name(); }
 std::string where(const host::SocketcandClientEndpoint& client) { return client.where(); }
-std::string where(const host::TmclPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
+std::string where(const host::TmclPtyEndpoint& pty) {
+  return pty.link_path() + " " + pty.device_path() + host::describe_line_echo(pty.echo());
+}
 std::string where(const host::SlcanPtyEndpoint& pty) { return pty.link_path() + " " + pty.device_path(); }
 
 // `opened` with its line "endpoint KIND WHERE", or its failure with `context` in front.
@@ -459,15 +481,18 @@ Result<OpenEndpoint> open_can_endpoint(host::EventLoop& loop, host::CanBus& bus,
 // TMCL over TCP (--tmcl-tcp) and on a pseudo-terminal (--tmcl-pty).
 Result<std::vector<OpenEndpoint>> open_tmcl_endpoints(host::HostRuntime& runtime, const EndpointPlan& plan) {
   std::vector<OpenEndpoint> endpoints;
-  for (const host::TcpEndpointSpec& spec : plan.tmcl_tcp) {
-    Result<OpenEndpoint> opened =
-        keep_open(host::TmclTcpServer::open(runtime.loop(), runtime.service(), spec), "tmcl-tcp", "");
+  for (const TmclTcpPlan& tcp : plan.tmcl_tcp) {
+    Result<OpenEndpoint> opened = keep_open(
+        host::TmclTcpServer::open(runtime.loop(), runtime.service(), tcp.spec, host::log_to_stderr, tcp.echo),
+        "tmcl-tcp", "");
     if (!opened) return Error{opened.error()};
     endpoints.push_back(std::move(*opened));
   }
   if (!plan.tmcl_pty_link.empty()) {
     Result<OpenEndpoint> opened =
-        keep_open(host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), plan.tmcl_pty_link), "tmcl-pty", "");
+        keep_open(host::TmclPtyEndpoint::open(runtime.loop(), runtime.service(), plan.tmcl_pty_link,
+                                              host::log_to_stderr, plan.tmcl_pty_echo),
+                  "tmcl-pty", "");
     if (!opened) return Error{opened.error()};
     endpoints.push_back(std::move(*opened));
   }
@@ -777,14 +802,17 @@ void add_serve_command(CLI::App& app, int& exit_status) {
   serve->add_option("--tmcl-tcp", arguments->tcp_endpoints,
                     "Serve TMCL over TCP (raw 9-byte frames, as PyTrinamic's socket interface sends them) on "
                     "HOST:PORT; HOST defaults to 127.0.0.1, port 0 picks a free port. Repeatable. Without any "
-                    "--tmcl-tcp or --tmcl-pty: 127.0.0.1:5000")
-      ->type_name("HOST:PORT")
+                    "--tmcl-tcp or --tmcl-pty: 127.0.0.1:5000. ,echo after the address: every byte a client sends "
+                    "comes back to it at once, before the reply, as an RS485 transceiver hands the host back what it "
+                    "transmits (Zephyr's TMCM RS485 bus driver waits for each byte's echo)")
+      ->type_name("HOST:PORT[,echo]")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   serve->add_option("--tmcl-pty", arguments->pty_link,
                     "Serve TMCL on a pseudo-terminal and make LINK a symbolic link to it (for pyserial and other "
-                    "serial-port software; the baud rate, and GP 65, have no effect)")
-      ->type_name("LINK");
+                    "serial-port software; the baud rate, and GP 65, have no effect). ,echo after LINK: every byte "
+                    "the client sends comes back at once, as on RS485 (see --tmcl-tcp); LINK has no comma")
+      ->type_name("LINK[,echo]");
   serve->add_option("--can", arguments->can_endpoints,
                     "Put the module on a virtual CAN bus served as socketcand[:HOST]:PORT (python-can's "
                     "interface='socketcand'), slcan-tcp:[HOST:]PORT (interface='slcan', "

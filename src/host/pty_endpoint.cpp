@@ -3,16 +3,17 @@
 namespace motwin::host {
 
 Result<std::unique_ptr<TmclPtyEndpoint>> TmclPtyEndpoint::open(EventLoop& loop, TmclHostService& service,
-                                                               const std::string& link_path, LogSink log) {
+                                                               const std::string& link_path, LogSink log,
+                                                               LineEcho echo) {
   const Result<PtyDevice> pty = open_pty_device(link_path);
   if (!pty) return Error{pty.error()};
-  return std::unique_ptr<TmclPtyEndpoint>(new TmclPtyEndpoint(loop, service, *pty, link_path, std::move(log)));
+  return std::unique_ptr<TmclPtyEndpoint>(new TmclPtyEndpoint(loop, service, *pty, link_path, std::move(log), echo));
 }
 
 TmclPtyEndpoint::TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, const PtyDevice& device,
-                                 std::string link_path, LogSink log)
-    : service_(service) {
-  channel_ = service_.open_channel(*this);
+                                 std::string link_path, LogSink log, LineEcho echo)
+    : service_(service), echo_(echo) {
+  channel_ = service_.open_channel(*this, tmcl::SerialFrameDecoder::kDefaultResyncGapUs, ChannelTraffic::kHost, echo);
   PtyPort::Handlers handlers;
   handlers.read_budget = [this] { return service_.input_room(channel_); };
   // Frames or ASCII lines, whichever mode the link is in (the echo comes back through send_reply).

@@ -35,8 +35,10 @@ class TmclPtyEndpoint final : public ReplyChannel {
 
   // Creates the pty and the link. An existing symbolic link is replaced when it is stale or
   // points into /dev/pts (left by an earlier run); anything else at `link_path` is an error.
+  // `echo`: the client's bytes go back to it as they arrive (an RS485 transceiver, LineEcho).
   static Result<std::unique_ptr<TmclPtyEndpoint>> open(EventLoop& loop, TmclHostService& service,
-                                                       const std::string& link_path, LogSink log = log_to_stderr);
+                                                       const std::string& link_path, LogSink log = log_to_stderr,
+                                                       LineEcho echo = LineEcho::kNone);
 
   TmclPtyEndpoint(const TmclPtyEndpoint&) = delete;
   TmclPtyEndpoint& operator=(const TmclPtyEndpoint&) = delete;
@@ -46,6 +48,7 @@ class TmclPtyEndpoint final : public ReplyChannel {
   const std::string& link_path() const { return port_->link_path(); }
   const std::string& device_path() const { return port_->device_path(); }
   tmcl::ChannelId channel() const { return channel_; }
+  LineEcho echo() const { return echo_; }
 
   // ReplyChannel.
   void send_reply(const uint8_t* bytes, size_t length) override;
@@ -53,9 +56,10 @@ class TmclPtyEndpoint final : public ReplyChannel {
 
  private:
   TmclPtyEndpoint(EventLoop& loop, TmclHostService& service, const PtyDevice& device, std::string link_path,
-                  LogSink log);
+                  LogSink log, LineEcho echo);
 
   TmclHostService& service_;
+  LineEcho echo_;
   tmcl::ChannelId channel_ = 0;
   std::unique_ptr<PtyPort> port_;
 };

@@ -106,9 +106,9 @@ std::string format_socket_address(const sockaddr_storage& address) {
 // connection's bounded buffer on the way out.
 class TmclTcpServer::Session final : public TcpSession, public ReplyChannel {
  public:
-  explicit Session(TmclHostService& service) : service_(service) {}
+  Session(TmclHostService& service, LineEcho echo) : service_(service), echo_(echo) {}
 
-  void on_open() override { channel_ = service_.open_channel(*this, kResyncGapUs); }
+  void on_open() override { channel_ = service_.open_channel(*this, kResyncGapUs, ChannelTraffic::kHost, echo_); }
 
   // Read no more than the service takes, so the rest waits in the kernel (back-pressure).
   size_t read_budget() const override { return input_closed_ ? 0 : service_.input_room(channel_); }
@@ -145,20 +145,24 @@ class TmclTcpServer::Session final : public TcpSession, public ReplyChannel {
   }
 
   TmclHostService& service_;
+  LineEcho echo_;
   tmcl::ChannelId channel_ = 0;
   bool input_closed_ = false;
 };
 
 Result<std::unique_ptr<TmclTcpServer>> TmclTcpServer::open(EventLoop& loop, TmclHostService& service,
-                                                           const TcpEndpointSpec& spec, LogSink log) {
+                                                           const TcpEndpointSpec& spec, LogSink log, LineEcho echo) {
   TcpConnectionServer::Config config{"TCP", kMaxClients, kMaxPendingOutputBytes, "it does not read its replies"};
   Result<std::unique_ptr<TcpConnectionServer>> connections = TcpConnectionServer::open(
       loop, spec, std::move(config),
-      [&service](TcpConnection&) -> std::unique_ptr<TcpSession> { return std::make_unique<Session>(service); },
+      [&service, echo](TcpConnection&) -> std::unique_ptr<TcpSession> {
+        return std::make_unique<Session>(service, echo);
+      },
       std::move(log));
   if (!connections) return Error{connections.error()};
   std::unique_ptr<TmclTcpServer> server(new TmclTcpServer());
   server->connections_ = std::move(*connections);
+  server->echo_ = echo;
   return server;
 }
 

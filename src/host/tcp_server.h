@@ -42,9 +42,11 @@ class TmclTcpServer {
   // A client that lets this much reply data pile up is not reading: it is disconnected.
   static constexpr size_t kMaxPendingOutputBytes = 64 * 1024;
 
-  // Fails with "cannot listen on 127.0.0.1:5000: Address already in use" and the like.
+  // Fails with "cannot listen on 127.0.0.1:5000: Address already in use" and the like. `echo`:
+  // each client's bytes go back to it as they arrive (an RS485 transceiver, LineEcho).
   static Result<std::unique_ptr<TmclTcpServer>> open(EventLoop& loop, TmclHostService& service,
-                                                     const TcpEndpointSpec& spec, LogSink log = log_to_stderr);
+                                                     const TcpEndpointSpec& spec, LogSink log = log_to_stderr,
+                                                     LineEcho echo = LineEcho::kNone);
 
   TmclTcpServer(const TmclTcpServer&) = delete;
   TmclTcpServer& operator=(const TmclTcpServer&) = delete;
@@ -54,12 +56,14 @@ class TmclTcpServer {
   std::string local_address() const;  // "127.0.0.1:40321", "[::1]:5000"
   uint16_t local_port() const;
   size_t client_count() const;
+  LineEcho echo() const { return echo_; }
 
  private:
   class Session;
   TmclTcpServer() = default;
 
   std::unique_ptr<TcpConnectionServer> connections_;
+  LineEcho echo_ = LineEcho::kNone;
 };
 
 // The descriptor of a non-blocking listening TCP socket (SO_REUSEADDR, backlog 16), or

@@ -17,7 +17,8 @@ LinkMode TmclHostService::start_mode() const {
   return settings.available && settings.start_in_ascii_mode ? LinkMode::kAscii : LinkMode::kBinary;
 }
 
-tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t resync_gap_us, ChannelTraffic traffic) {
+tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t resync_gap_us, ChannelTraffic traffic,
+                                              LineEcho echo) {
   // Skip ids still in use, or with requests or a held reply from a connection that just went.
   for (uint32_t attempt = 0; attempt <= UINT16_MAX; ++attempt) {
     const tmcl::ChannelId id = next_channel_id_;
@@ -26,8 +27,9 @@ tmcl::ChannelId TmclHostService::open_channel(ReplyChannel& channel, uint32_t re
         (held_ && held_->channel == id)) {
       continue;
     }
-    channels_.emplace(id,
-                      Channel{&channel, start_mode(), traffic, tmcl::SerialFrameDecoder(resync_gap_us), {}, {}, false});
+    if (echo == LineEcho::kTransceiver) resync_gap_us = std::max(resync_gap_us, kEchoResyncGapUs);
+    channels_.emplace(
+        id, Channel{&channel, start_mode(), traffic, echo, tmcl::SerialFrameDecoder(resync_gap_us), {}, {}, false});
     return id;
   }
   // 65535 simultaneous connections: the transports limit their clients far below that.
@@ -82,6 +84,12 @@ size_t TmclHostService::input_room(tmcl::ChannelId id) const {
 
 void TmclHostService::receive(tmcl::ChannelId id, const uint8_t* bytes, size_t length, uint64_t now_us,
                               std::optional<uint64_t> quiet_seen_us) {
+  const auto echoing = channels_.find(id);
+  if (echoing != channels_.end() && echoing->second.echo == LineEcho::kTransceiver) {
+    // The transceiver hands the bytes back as they pass, before the module has read them.
+    send_to(id, bytes, length);
+  }
+  // Sending may have closed the channel.
   const auto found = channels_.find(id);
   if (found == channels_.end()) return;
   Channel& channel = found->second;

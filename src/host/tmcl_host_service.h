@@ -51,6 +51,12 @@ enum class LinkMode : uint8_t { kBinary, kAscii };
 // their period, and a page's own requests already arrive as input on a descriptor.
 enum class ChannelTraffic : uint8_t { kHost, kBackground };
 
+// What the host hears of its own bytes. On RS485 the transceiver's receiver stays on while the
+// host transmits, so every byte the host sends comes straight back to it, ahead of any reply;
+// Zephyr's TMCM RS485 bus driver waits for each byte's echo before it sends the next. The
+// transceiver knows nothing of TMCL: garbage and ASCII lines come back too.
+enum class LineEcho : uint8_t { kNone, kTransceiver };
+
 class TmclHostService final : public tmcl::ReplySink {
  public:
   // A connection with this many requests waiting stops being read until some are served, so
@@ -59,6 +65,13 @@ class TmclHostService final : public tmcl::ReplySink {
   // Received bytes not yet read as frames or lines (waiting for a reply that may switch the
   // link's mode); a connection with this many is not read until they are.
   static constexpr size_t kMaxPendingInputBytes = 4096;
+  // The least resync gap of a channel with LineEcho::kTransceiver. A host that waits for each
+  // byte's echo before it sends the next puts a round trip through the transport and two
+  // schedulers into every gap between its bytes: on a loaded machine more than a serial line's
+  // 5 ms, and more than 200 ms has been seen (docs/host-runtime.md, "RS485 echo"). 1 s is the
+  // longest Zephyr's driver waits for a byte (of a reply); a host that gives up on a frame
+  // pauses that long before its next one is read afresh.
+  static constexpr uint32_t kEchoResyncGapUs = 1'000'000;
 
   TmclHostService(tmcl::TmclEngine& engine, EventLoop& loop);
   TmclHostService(const TmclHostService&) = delete;
@@ -66,10 +79,12 @@ class TmclHostService final : public tmcl::ReplySink {
   ~TmclHostService();
 
   // Never returns 0 (channel 0 is what the engine uses for a stored program). `resync_gap_us`:
-  // a pause this long between two bytes discards a partial binary frame.
+  // a pause this long between two bytes discards a partial binary frame. `echo`: whether the
+  // bytes the channel receives go back to it at once (an RS485 transceiver, LineEcho); with the
+  // echo the gap is at least kEchoResyncGapUs.
   tmcl::ChannelId open_channel(ReplyChannel& channel,
                                uint32_t resync_gap_us = tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
-                               ChannelTraffic traffic = ChannelTraffic::kHost);
+                               ChannelTraffic traffic = ChannelTraffic::kHost, LineEcho echo = LineEcho::kNone);
   // Requests already queued from this channel still run (their bytes arrived, as on a serial
   // line); their replies and any pending command 138 events of the channel are dropped.
   void close_channel(tmcl::ChannelId id);
@@ -80,8 +95,9 @@ class TmclHostService final : public tmcl::ReplySink {
   tmcl::ChannelId open_event_channel(tmcl::ReplySink& sink);
   void close_event_channel(tmcl::ChannelId id);
 
-  // Bytes a connection received, in arrival order; at most input_room(id) of them. Complete
-  // frames and lines become requests; the echo of ASCII mode goes out at once. `now_us`: when
+  // Bytes a connection received, in arrival order; at most input_room(id) of them. On a channel
+  // with LineEcho::kTransceiver they go back to it first, all of them, before anything they
+  // cause. Complete frames and lines become requests; the echo of ASCII mode goes out at once. `now_us`: when
   // they were read; `quiet_seen_us`: when the loop last saw the connection quiet before them
   // (EventLoop::quiet_seen_us). Only that silence counts towards the resync gap of binary
   // framing; without it the whole time since the previous bytes does.
@@ -130,6 +146,7 @@ class TmclHostService final : public tmcl::ReplySink {
     ReplyChannel* sink = nullptr;
     LinkMode mode = LinkMode::kBinary;
     ChannelTraffic traffic = ChannelTraffic::kHost;
+    LineEcho echo = LineEcho::kNone;
     tmcl::SerialFrameDecoder decoder;
     tmcl::AsciiLink ascii;
     std::deque<PendingByte> input;

@@ -431,6 +431,8 @@ class Server:
             setattr(self, attribute, None)
         self.pty_link = None
         self.pty_device = None
+        self.tcp_echo = False  # the endpoint line said " echo"
+        self.pty_echo = False
         self._stderr_file = None
         self._stdout_thread = None
         self.returncode = None
@@ -512,15 +514,18 @@ class Server:
             self.banner = text
             self.eeprom_path = m.group(1)
             return False
-        m = re.fullmatch(r"endpoint (\S+) 127\.0\.0\.1:(\d+)", text)
-        if m and m.group(1) in self.PORT_ENDPOINTS:
+        # A TMCL endpoint given ",echo" (the RS485 transceiver's echo) says " echo" at the end.
+        m = re.fullmatch(r"endpoint (\S+) 127\.0\.0\.1:(\d+)( echo)?", text)
+        if m and m.group(1) in self.PORT_ENDPOINTS and (m.group(3) is None or m.group(1) == "tmcl-tcp"):
             port = int(m.group(2))
             check(0 < port < 65536, f"bad port in {text!r}")
             setattr(self, self.PORT_ENDPOINTS[m.group(1)], port)
+            if m.group(1) == "tmcl-tcp":
+                self.tcp_echo = m.group(3) is not None
             return False
-        m = re.fullmatch(r"endpoint tmcl-pty (\S+) (/dev/pts/\d+)", text)
+        m = re.fullmatch(r"endpoint tmcl-pty (\S+) (/dev/pts/\d+)( echo)?", text)
         if m:
-            self.pty_link, self.pty_device = m.group(1), m.group(2)
+            self.pty_link, self.pty_device, self.pty_echo = m.group(1), m.group(2), m.group(3) is not None
             return False
         raise ServerError(f"unexpected line on serve's stdout: {text!r} (all: {self.stdout_lines!r})")
 

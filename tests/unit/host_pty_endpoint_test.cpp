@@ -48,6 +48,7 @@ class SerialTestClient {
     out.swap(received_);
     return out;
   }
+  const Bytes& received() const { return received_; }
 
  private:
   int fd_ = -1;
@@ -58,9 +59,9 @@ class PtyEndpointTest : public ::testing::Test {
  protected:
   std::string link() const { return (scratch_.path() / "tmcm1636").string(); }
 
-  void open_endpoint() {
-    Result<std::unique_ptr<TmclPtyEndpoint>> opened =
-        TmclPtyEndpoint::open(rig_.runtime->loop(), rig_.runtime->service(), link(), [](const std::string&) {});
+  void open_endpoint(LineEcho echo = LineEcho::kNone) {
+    Result<std::unique_ptr<TmclPtyEndpoint>> opened = TmclPtyEndpoint::open(
+        rig_.runtime->loop(), rig_.runtime->service(), link(), [](const std::string&) {}, echo);
     ASSERT_TRUE(opened) << opened.error();
     endpoint_ = std::move(*opened);
   }
@@ -99,6 +100,32 @@ TEST_F(PtyEndpointTest, clients_may_open_and_close_the_device_repeatedly) {
   EXPECT_EQ(rig_.runtime->loop().poll_once(0), 0u);
   SerialTestClient last(link());
   EXPECT_EQ(exchange(last, request(kGap, 43, 0, 0)), reply(100, kGap, 1004));
+}
+
+// The RS485 transceiver's echo, as Zephyr's TMCM RS485 bus driver uses it: it writes one byte and
+// waits for that byte to come back before it writes the next; after the ninth echo it reads the
+// reply. Nothing but the echo may come back before the ninth byte.
+TEST_F(PtyEndpointTest, with_the_echo_each_byte_comes_back_before_the_next_is_sent_then_the_reply) {
+  open_endpoint(LineEcho::kTransceiver);
+  EXPECT_EQ(endpoint_->echo(), LineEcho::kTransceiver);
+  SerialTestClient client(link());
+  ASSERT_TRUE(client.is_open());
+  for (int32_t value : {2000, 3200}) {
+    SCOPED_TRACE(value);
+    const Bytes frame = request(kSap, 43, 0, value);
+    for (size_t i = 0; i < frame.size(); ++i) {
+      client.send(Bytes{frame[i]});
+      ASSERT_TRUE(testing::pump_until([this] { rig_.step(); }, [&] { return client.has(i + 1); }));
+      if (i + 1 < frame.size()) {
+        EXPECT_EQ(client.received(), slice(frame, 0, i + 1)) << "after byte " << i;
+      }
+    }
+    ASSERT_TRUE(testing::pump_until([this] { rig_.step(); }, [&] { return client.has(18); }));
+    Bytes expected = frame;
+    const Bytes answer = reply(100, kSap, value);
+    expected.insert(expected.end(), answer.begin(), answer.end());
+    EXPECT_EQ(client.take(), expected);
+  }
 }
 
 // A pty passes a client's bytes on to the master asynchronously (a kernel worker), and the loop

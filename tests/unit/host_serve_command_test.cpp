@@ -134,6 +134,37 @@ TEST(ServeCommand, prints_its_endpoints_answers_tmcl_and_stops_cleanly_on_sigter
   EXPECT_TRUE(std::filesystem::exists(state + "/tmcm-1636.eeprom"));
 }
 
+// ,echo after an address: that endpoint only echoes (the RS485 transceiver), and its line says so.
+TEST(ServeCommand, the_echo_option_is_per_endpoint_and_shown_in_its_line) {
+  testing::ScratchDirectory scratch;
+  const std::string link = (scratch.path() / "rs485").string();
+  ServeProcess serve({"--module", "tmcm-1636", "--tmcl-tcp", "127.0.0.1:0,echo", "--tmcl-tcp", "127.0.0.1:0",
+                      "--tmcl-pty", link + ",echo", "--state-dir", "none"});
+  const std::vector<std::string> lines = serve.lines_until_ready();
+  ASSERT_EQ(lines.size(), 5u) << serve.read_stderr();
+  const std::string tcp_prefix = "endpoint tmcl-tcp 127.0.0.1:";
+  ASSERT_EQ(lines[1].rfind(tcp_prefix, 0), 0u) << lines[1];
+  EXPECT_TRUE(lines[1].ends_with(" echo")) << lines[1];
+  ASSERT_EQ(lines[2].rfind(tcp_prefix, 0), 0u) << lines[2];
+  EXPECT_EQ(lines[2].find(' ', tcp_prefix.size()), std::string::npos) << lines[2];
+  EXPECT_EQ(lines[3].rfind("endpoint tmcl-pty " + link + " /dev/pts/", 0), 0u) << lines[3];
+  EXPECT_TRUE(lines[3].ends_with(" echo")) << lines[3];
+  EXPECT_TRUE(std::filesystem::is_symlink(link)) << "the link has no option in its name";
+  {
+    testing::TcpTestClient echoing(static_cast<uint16_t>(std::stoi(lines[1].substr(tcp_prefix.size()))));
+    testing::TcpTestClient plain(static_cast<uint16_t>(std::stoi(lines[2].substr(tcp_prefix.size()))));
+    const Bytes frame = request(6, 43, 0, 0);  // GAP 43: max velocity
+    echoing.send(frame);
+    plain.send(frame);
+    ASSERT_TRUE(testing::pump_until([] { ::usleep(1000); }, [&] { return echoing.has(18) && plain.has(9); }));
+    EXPECT_EQ(echoing.take(9), frame);
+    EXPECT_EQ(echoing.take(9), reply(100, 6, 4000));
+    EXPECT_EQ(plain.take(9), reply(100, 6, 4000));
+  }
+  serve.signal(SIGTERM);
+  EXPECT_EQ(serve.wait(), 0);
+}
+
 TEST(ServeCommand, bad_arguments_exit_with_status_2_and_one_error_line) {
   testing::ScratchDirectory scratch;
   const std::string scenario = (scratch.path() / "bad.scn").string();
@@ -141,6 +172,12 @@ TEST(ServeCommand, bad_arguments_exit_with_status_2_and_one_error_line) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--tmcl-tcp", "127.0.0.1:70000"},
        "motwin: error: --tmcl-tcp: expected HOST:PORT with a port from 0 to 65535, got \"127.0.0.1:70000\"\n"},
+      {{"--tmcl-tcp", "127.0.0.1:0,ecko"},
+       "motwin: error: --tmcl-tcp: unknown option \"ecko\" in \"127.0.0.1:0,ecko\": the options after the address "
+       "are echo (and the address has no comma)\n"},
+      {{"--tmcl-pty", "/tmp/motwin-test-link,rs485"},
+       "motwin: error: --tmcl-pty: unknown option \"rs485\" in \"/tmp/motwin-test-link,rs485\": the options after "
+       "the address are echo (and the address has no comma)\n"},
       {{"--module", "tmcm-9"}, "motwin: error: unknown module \"tmcm-9\" (available: tmcm-1636, tmcm-142, tmcm-3216)\n"},
       {{"--speed", "slow"},
        "motwin: error: --speed takes realtime, fast or a factor from 0.001 to 10000, got \"slow\"\n"},

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "host/tcp_server.h"
+#include "host/tmcl_endpoint_options.h"
 #include "support/host_test_support.h"
 
 namespace motwin::host {
@@ -48,6 +49,26 @@ class TcpServerTest : public ::testing::Test {
   std::vector<std::string> log_;
   std::unique_ptr<TmclTcpServer> server_;  // destroyed before rig_
 };
+
+// --tmcl-tcp and --tmcl-pty take the same options after their address.
+TEST(TmclEndpointArgument, the_first_comma_ends_the_address_and_echo_is_the_one_option) {
+  EXPECT_EQ(parse_tmcl_endpoint_argument("127.0.0.1:0")->address, "127.0.0.1:0");
+  EXPECT_EQ(parse_tmcl_endpoint_argument("127.0.0.1:0")->echo, LineEcho::kNone);
+  EXPECT_EQ(parse_tmcl_endpoint_argument("127.0.0.1:0,echo")->address, "127.0.0.1:0");
+  EXPECT_EQ(parse_tmcl_endpoint_argument("127.0.0.1:0,echo")->echo, LineEcho::kTransceiver);
+  EXPECT_EQ(parse_tmcl_endpoint_argument("[::1]:5000,echo")->address, "[::1]:5000");
+  EXPECT_EQ(parse_tmcl_endpoint_argument("/tmp/tmcm3216,echo")->address, "/tmp/tmcm3216");
+  EXPECT_EQ(parse_tmcl_endpoint_argument("/tmp/tmcm3216,echo,echo")->echo, LineEcho::kTransceiver);
+  EXPECT_EQ(parse_tmcl_endpoint_argument("/tmp/a,b").error(),
+            "unknown option \"b\" in \"/tmp/a,b\": the options after the address are echo (and the address has "
+            "no comma)");
+  EXPECT_FALSE(parse_tmcl_endpoint_argument("/tmp/tmcm3216,"));
+  EXPECT_FALSE(parse_tmcl_endpoint_argument("/tmp/tmcm3216,Echo"));
+  EXPECT_EQ(parse_tmcl_endpoint_argument(",echo").error(),
+            "expected an address before the options (ADDRESS[,echo]), got \",echo\"");
+  EXPECT_EQ(describe_line_echo(LineEcho::kTransceiver), " echo");
+  EXPECT_EQ(describe_line_echo(LineEcho::kNone), "");
+}
 
 TEST(TcpEndpointSpec, parses_host_and_port) {
   EXPECT_EQ(parse_tcp_endpoint("127.0.0.1:5000")->host, "127.0.0.1");
@@ -313,6 +334,32 @@ TEST_F(TcpServerTest, shutting_the_server_down_closes_its_clients) {
   pump_until([this] { return server_->client_count() == 1; });
   server_.reset();
   EXPECT_TRUE(client.closed_by_peer());
+}
+
+// The RS485 transceiver's echo on TCP (`--tmcl-tcp HOST:PORT,echo`): a client writing a byte at a
+// time gets each back before it writes the next, then the reply; a client of a server without
+// it gets only the reply.
+TEST_F(TcpServerTest, with_the_echo_each_byte_comes_back_as_it_arrives_then_the_reply) {
+  Result<std::unique_ptr<TmclTcpServer>> opened =
+      TmclTcpServer::open(rig_.runtime->loop(), rig_.runtime->service(), TcpEndpointSpec{"127.0.0.1", 0},
+                          [](const std::string&) {}, LineEcho::kTransceiver);
+  ASSERT_TRUE(opened) << opened.error();
+  const std::unique_ptr<TmclTcpServer> echoing = std::move(*opened);
+  EXPECT_EQ(echoing->echo(), LineEcho::kTransceiver);
+  EXPECT_EQ(server_->echo(), LineEcho::kNone);
+  TcpTestClient client(echoing->local_port());
+  const Bytes frame = request(kSap, 43, 0, 1234);
+  for (size_t i = 0; i < frame.size(); ++i) {
+    client.send(Bytes{frame[i]});
+    EXPECT_EQ(receive(client, 1), Bytes{frame[i]}) << "byte " << i;
+  }
+  EXPECT_EQ(receive(client, 9), reply(100, kSap, 1234));
+  TcpTestClient plain(server_->local_port());
+  plain.send(request(kGap, 43, 0, 0));
+  EXPECT_EQ(receive(plain, 9), reply(100, kGap, 1234)) << "no echo on the other server";
+  settle();
+  EXPECT_EQ(client.receive_available(), Bytes{});
+  EXPECT_EQ(plain.receive_available(), Bytes{});
 }
 
 }  // namespace

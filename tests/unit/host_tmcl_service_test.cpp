@@ -1,8 +1,10 @@
 // TmclHostService's serving order (docs/host-runtime.md, "Serving order"): each connection's
 // requests in their order, connections in turn, so a flooding client cannot hold another
-// client's request behind its whole queue.
+// client's request behind its whole queue. And the RS485 transceiver's echo (LineEcho): each
+// byte back as it arrives, ahead of the reply, whatever the bytes are.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -127,6 +129,109 @@ TEST_F(TmclServiceOrder, a_closed_connections_requests_run_in_their_turns_withou
   service_->receive(id, ggp.data(), ggp.size(), 0);
   serve_all();
   EXPECT_EQ(log_.back(), "d3");
+}
+
+// A connection that keeps every byte it is sent, in order.
+struct RecordingChannel final : ReplyChannel {
+  void send_reply(const uint8_t* bytes, size_t length) override { heard.insert(heard.end(), bytes, bytes + length); }
+  testing::Bytes heard;
+};
+
+testing::Bytes joined(const testing::Bytes& first, const testing::Bytes& second) {
+  testing::Bytes both = first;
+  both.insert(both.end(), second.begin(), second.end());
+  return both;
+}
+
+class TmclServiceEcho : public TmclServiceOrder {
+ protected:
+  // Hands the bytes to the service one at a time, `spacing_us` apart on the line, serving after
+  // each as the host runtime does between its polls; `after_each` sees the channel after each.
+  void send_bytewise(tmcl::ChannelId id, const testing::Bytes& bytes, uint64_t spacing_us,
+                     const std::function<void(size_t sent)>& after_each) {
+    for (size_t i = 0; i < bytes.size(); ++i) {
+      now_us_ += spacing_us;
+      service_->receive(id, &bytes[i], 1, now_us_);
+      after_each(i + 1);
+      serve_all();
+    }
+  }
+  uint64_t now_us_ = 0;
+};
+
+// What Zephyr's TMCM RS485 bus driver does: a byte, its echo, the next byte ... and after the
+// ninth echo the reply. A channel without the echo beside it hears only its reply. The bytes are
+// 200 ms apart, as a host waiting for each echo on a loaded machine may send them: far more than
+// a serial line's resync gap, less than an echoing link's (kEchoResyncGapUs).
+TEST_F(TmclServiceEcho, each_byte_comes_back_as_it_arrives_and_the_reply_follows_the_ninth) {
+  RecordingChannel rs485, plain;
+  const tmcl::ChannelId echoing = service_->open_channel(rs485, tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
+                                                         ChannelTraffic::kHost, LineEcho::kTransceiver);
+  const tmcl::ChannelId quiet = service_->open_channel(plain);
+  const testing::Bytes sap = testing::request(5, 43, 0, 2000);  // SAP 43 (max velocity), 0, 2000
+  send_bytewise(echoing, sap, 200'000, [&](size_t sent) {
+    EXPECT_EQ(rs485.heard, testing::slice(sap, 0, sent)) << "after byte " << sent;
+  });
+  EXPECT_EQ(rs485.heard, joined(sap, testing::reply(100, 5, 2000)));
+  const testing::Bytes gap = testing::request(6, 43, 0, 0);
+  service_->receive(quiet, gap.data(), gap.size(), now_us_);
+  serve_all();
+  EXPECT_EQ(plain.heard, testing::reply(100, 6, 2000));
+  EXPECT_EQ(rs485.heard.size(), 18u) << "another connection's traffic is not echoed here";
+}
+
+// The transceiver knows nothing of TMCL: a bad checksum, a frame for another module on the bus
+// and a burst of several frames come back whole, and every reply still after its frame's echo.
+TEST_F(TmclServiceEcho, garbage_and_other_modules_frames_are_echoed_too) {
+  RecordingChannel rs485;
+  const tmcl::ChannelId id = service_->open_channel(rs485, tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
+                                                    ChannelTraffic::kHost, LineEcho::kTransceiver);
+  testing::Bytes bad_checksum = testing::request(9, 0, 2, 7);
+  bad_checksum.back() ^= 0x55;
+  send_bytewise(id, bad_checksum, 1000, [&](size_t sent) {
+    EXPECT_EQ(rs485.heard, testing::slice(bad_checksum, 0, sent));
+  });
+  EXPECT_EQ(rs485.heard, joined(bad_checksum, testing::reply(1, 0, 0))) << "status 1 after the echo";
+  rs485.heard.clear();
+  const testing::Bytes other_module = testing::request(9, 0, 2, 7, /*address=*/2);
+  service_->receive(id, other_module.data(), other_module.size(), now_us_ += 10'000);
+  serve_all();
+  EXPECT_EQ(rs485.heard, other_module) << "echoed, and not answered";
+  rs485.heard.clear();
+  // A host that gives up on a frame and pauses for the gap starts afresh; the echo is of all.
+  const testing::Bytes abandoned = testing::slice(testing::request(9, 0, 2, 99), 0, 4);
+  service_->receive(id, abandoned.data(), abandoned.size(), now_us_ += 10'000);
+  const testing::Bytes fresh = testing::request(9, 0, 2, 8);
+  service_->receive(id, fresh.data(), fresh.size(), now_us_ += TmclHostService::kEchoResyncGapUs + 1000);
+  serve_all();
+  EXPECT_EQ(rs485.heard, joined(joined(abandoned, fresh), testing::reply(100, 9, 8)));
+  rs485.heard.clear();
+  const testing::Bytes burst = joined(testing::request(9, 1, 2, 11), testing::request(10, 1, 2, 0));
+  service_->receive(id, burst.data(), burst.size(), now_us_ += 10'000);
+  EXPECT_EQ(rs485.heard, burst) << "the echo of a burst precedes every reply";
+  serve_all();
+  EXPECT_EQ(rs485.heard, joined(burst, joined(testing::reply(100, 9, 11), testing::reply(100, 10, 11))));
+}
+
+// The transceiver sits below the protocol: in ASCII mode (command 139) each character comes
+// back from it, then the firmware's own echo of the character, then the reply line.
+TEST_F(TmclServiceEcho, ascii_mode_gets_the_transceivers_echo_before_the_firmwares) {
+  RecordingChannel rs485;
+  const tmcl::ChannelId id = service_->open_channel(rs485, tmcl::SerialFrameDecoder::kDefaultResyncGapUs,
+                                                    ChannelTraffic::kHost, LineEcho::kTransceiver);
+  const testing::Bytes enter_ascii = testing::request(139, 0, 0, 0);
+  service_->receive(id, enter_ascii.data(), enter_ascii.size(), now_us_);
+  serve_all();
+  EXPECT_EQ(rs485.heard, joined(enter_ascii, testing::reply(100, 139, 0)));
+  ASSERT_EQ(service_->link_mode(id), LinkMode::kAscii);
+  rs485.heard.clear();
+  const std::string line = "AGAP 43, 0\r";  // AP 43: max velocity, 4000 at factory
+  std::string expected;
+  for (const char c : line) expected += std::string(2, c);  // the transceiver's, then the firmware's
+  send_bytewise(id, testing::Bytes(line.begin(), line.end()), 1000, [&](size_t sent) {
+    EXPECT_EQ(std::string(rs485.heard.begin(), rs485.heard.end()), expected.substr(0, 2 * sent));
+  });
+  EXPECT_EQ(std::string(rs485.heard.begin(), rs485.heard.end()), expected + "BA 100 4000\r");
 }
 
 }  // namespace
