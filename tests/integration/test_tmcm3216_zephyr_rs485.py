@@ -16,7 +16,7 @@ acceleration, set_reference_position (SAP 1), move_by (MVP REL) and move_to (MVP
 by is_moving polls every 100 ms (GAP 8, then GAP 3; moving while AP 8 == 0 and AP 3 != 0),
 tmcm3216_get_status (GAP 1, 3, 8, 10, 11), run (GAP 4, then ROR or ROL at that velocity), stop
 (MST), disable (MST, SAP 6 = 0, SAP 7 = 0). A right stop switch at position 8000
-(`--set AXIS0_REF_R_AT=0.15625`) stops the positive run; AP 10 says so.
+(`--set AXIS0_REF_R_AT=2.5`) stops the positive run; AP 10 says so.
 
 Without `,echo` the same link gives no echo: a frame's reply is the first 9 bytes read.
 """
@@ -40,10 +40,9 @@ MICROSTEP_RESOLUTION = 140
 MICROSTEPS = 16                      # the devicetree's micro-step-res (the binding's default)
 # The right stop switch, in AP 1 units: far enough out that the positive run spends seconds at full
 # speed before it gets there, so the status polls see that speed however slowly a loaded machine
-# answers them. The simulated rotor turns once per 51200 of AP 1 whatever AP 140 says (--set takes
-# revolutions).
+# answers them. At AP 140 = 4 the rotor turns once per 3200 of AP 1 (--set takes revolutions).
 RIGHT_SWITCH_AT = 8000
-ROTOR_MICROSTEPS_PER_REVOLUTION = 200 * 256
+ROTOR_MICROSTEPS_PER_REVOLUTION = 200 * MICROSTEPS
 POLL_INTERVAL_S = 0.1                # TMCM3216_POLL_INTERVAL_MS: the driver's rhythm, not a bound
 POLL_BUDGET_MS = 60000               # simulated time a move or a run may take before the test gives up
 TICK_TIMER = 132                     # GP, simulated milliseconds

@@ -359,5 +359,26 @@ TEST(Tmcm3216TmclFeatures, interrupts_of_each_axis_and_input_run_their_routines)
   EXPECT_EQ(rig.command(cmd::kGgp, 2, kVars, 0).value, 3000) << "motor 2 arrived";
 }
 
+// AP 140 on a running module: the new resolution applies once the axis stands still (the
+// TMCL firmware has no power-off state in which the CANopen firmware applies 2000).
+TEST(Tmcm3216TmclFeatures, a_new_microstep_resolution_applies_at_standstill) {
+  Tmcm3216TmclRig rig;
+  rig.run_ms(10);  // the power stage is on
+  ASSERT_EQ(rig.command(kRor, 0, 1, 12800).status, 100);
+  rig.run_ms(500);
+  ASSERT_EQ(rig.sap(140, 1, 4), 100);  // 16 microsteps, while moving
+  rig.run_ms(10);
+  EXPECT_EQ(rig.module->axis(1).stepper.active_microstep_code(), 8) << "not while moving";
+  ASSERT_EQ(rig.command(kMst, 0, 1, 0).status, 100);
+  rig.run_ms(1000);
+  EXPECT_EQ(rig.module->axis(1).stepper.active_microstep_code(), 4);
+  const double before = rig.board.rotor_revolutions(1);
+  ASSERT_EQ(rig.command(kMvp, 1, 1, 3200).status, 100);  // AP 127 = 0: from the last target
+  ASSERT_EQ(rig.sap(127, 1, 1), 100);
+  ASSERT_EQ(rig.command(kMvp, 1, 1, 3200).status, 100);  // from the actual position
+  ASSERT_GE(rig.ms_until_reached(1, 5000), 0);
+  EXPECT_NEAR(rig.board.rotor_revolutions(1) - before, 1.0, 0.01) << "3200 steps of 1/16: one revolution";
+}
+
 }  // namespace
 }  // namespace motwin::testing

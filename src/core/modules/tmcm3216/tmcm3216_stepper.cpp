@@ -76,8 +76,11 @@ int32_t Tmcm3216Stepper::current_of_scale(uint8_t scale) const {
 void Tmcm3216Stepper::tick(board::StepperPowerStage& stage, const StepperDemand& demand, uint32_t dt_us) {
   const board::StepperFeedback& feedback = stage.feedback;
   switch_on_disabled_ = demand.switch_on_disabled;
-  // A new resolution (2000) takes effect while the power stage is off (docs "Decisions").
-  if (!power_on_) active_microstep_code_ = objects.microstep_code <= 8 ? objects.microstep_code : 8;
+  // A new resolution (2000) takes effect while the power stage is off (docs "Decisions"), or
+  // when the demand allows it.
+  if (!power_on_ || demand.resolution_change_allowed) {
+    active_microstep_code_ = objects.microstep_code <= 8 ? objects.microstep_code : 8;
+  }
 
   read_switches(feedback.switches);
   // The sensors saw the rotor where the previous demand put the field.

@@ -114,6 +114,9 @@ struct StepperDemand {
   bool power_enabled = false;   // PDS: power stage on (switched on, operation enabled, stopping)
   bool brake_released_request = false;  // PDS: operation enabled, the brake may open
   bool switch_on_disabled = true;       // PDS in SWITCH ON DISABLED: 2005/200B/200C writable
+  // A new resolution (2000) may take effect now although the power stage is on: the TMCL
+  // firmware, which has no power-off state, applies AP 140 at standstill.
+  bool resolution_change_allowed = false;
 };
 
 // Switch inputs after 2005: `left/right/home` are the active levels (inversion applied) of the

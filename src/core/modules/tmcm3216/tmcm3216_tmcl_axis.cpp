@@ -329,6 +329,7 @@ void Tmcm3216TmclAxis::tick(board::StepperPowerStage& stage, uint32_t dt_us) {
   demand.power_enabled = true;
   demand.brake_released_request = true;
   demand.switch_on_disabled = true;  // every stepper setting is writable at any time
+  demand.resolution_change_allowed = ramp_.standstill();  // AP 140 takes effect at standstill
   stepper.tick(stage, demand, dt_us);
 }
 
