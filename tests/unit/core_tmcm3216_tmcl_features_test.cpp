@@ -380,5 +380,84 @@ TEST(Tmcm3216TmclFeatures, a_new_microstep_resolution_applies_at_standstill) {
   EXPECT_NEAR(rig.board.rotor_revolutions(1) - before, 1.0, 0.01) << "3200 steps of 1/16: one revolution";
 }
 
+// AP 43..46: OUT1 pulses for AP 46 ms at every compare point AP 1 passes (AP 43 + k x AP 44),
+// both ways; AP 47: OUT3 high while AP 8 reads 1.
+TEST(Tmcm3216TmclFeatures, position_compare_pulses_an_output_at_each_point_and_47_shows_target_reached) {
+  Tmcm3216TmclRig rig;
+  ASSERT_EQ(rig.sap(43, 0, 1000), 100);
+  ASSERT_EQ(rig.sap(44, 0, 2000), 100);
+  ASSERT_EQ(rig.sap(45, 0, 2), 100);  // OUT1
+  ASSERT_EQ(rig.sap(46, 0, 2), 100);  // 2 ms
+  ASSERT_EQ(rig.sap(47, 0, 8), 100);  // OUT3
+  ASSERT_EQ(rig.sap(4, 0, 10000), 100);
+  ASSERT_EQ(rig.sap(5, 0, 1000000), 100);
+  ASSERT_EQ(rig.sap(17, 0, 1000000), 100);
+  rig.tick();
+  const auto& io = rig.board.board().io;
+  EXPECT_TRUE(io.output_levels[3]) << "at rest on its target at power-up";
+  // Points at 1000, 3000, 5000, 7000 on the way to 8000: four pulses, rising edges counted.
+  ASSERT_EQ(rig.command(kMvp, 0, 0, 8000).status, 100);
+  int pulses = 0;
+  int longest_ticks = 0;
+  int ticks_high = 0;
+  bool previous = false;
+  bool reached_output_seen_low = false;
+  for (int t = 0; t < 20000 && rig.gap(8, 0) == 0; ++t) {
+    rig.tick();
+    const bool level = io.output_levels[1];
+    if (level && !previous) ++pulses;
+    ticks_high = level ? ticks_high + 1 : 0;
+    if (ticks_high > longest_ticks) longest_ticks = ticks_high;
+    previous = level;
+    if (!io.output_levels[3]) reached_output_seen_low = true;
+  }
+  EXPECT_EQ(rig.gap(1, 0), 8000);
+  EXPECT_EQ(pulses, 4);
+  EXPECT_EQ(longest_ticks, 40) << "2 ms of 50 µs ticks";
+  EXPECT_TRUE(reached_output_seen_low);
+  rig.tick();
+  EXPECT_TRUE(io.output_levels[3]) << "on the target again";
+  // Back to 0: the points again, moving down.
+  ASSERT_EQ(rig.command(kMvp, 0, 0, 0).status, 100);
+  pulses = 0;
+  previous = false;
+  for (int t = 0; t < 20000 && rig.gap(8, 0) == 0; ++t) {
+    rig.tick();
+    const bool level = io.output_levels[1];
+    if (level && !previous) ++pulses;
+    previous = level;
+  }
+  EXPECT_EQ(pulses, 4);
+  // AP 1 re-based by a write passes no point.
+  rig.run_ms(5);
+  ASSERT_EQ(rig.sap(1, 0, 6000), 100);
+  rig.run_ms(1);
+  EXPECT_FALSE(io.output_levels[1]);
+}
+
+// AP 48: a move waits for a masked input (IN1 = DIO1) and starts when it goes high.
+TEST(Tmcm3216TmclFeatures, a_move_waits_for_the_motion_start_input) {
+  Tmcm3216TmclRig rig;
+  ASSERT_EQ(rig.sap(48, 2, 2), 100);  // IN1
+  ASSERT_EQ(rig.command(kMvp, 0, 2, 5000).status, 100);
+  rig.run_ms(200);
+  EXPECT_EQ(rig.gap(1, 2), 0) << "held";
+  EXPECT_EQ(rig.gap(8, 2), 0);
+  EXPECT_TRUE(rig.module->axis(2).motion_start_pending());
+  rig.board.set_input("DIO1", 1);
+  EXPECT_GE(rig.ms_until_reached(2, 2000), 0);
+  EXPECT_EQ(rig.gap(1, 2), 5000);
+  // MST drops a held start.
+  rig.board.set_input("DIO1", 0);
+  rig.run_ms(1);
+  ASSERT_EQ(rig.command(kRor, 0, 2, 10000).status, 100);
+  ASSERT_EQ(rig.command(kMst, 0, 2, 0).status, 100);
+  EXPECT_FALSE(rig.module->axis(2).motion_start_pending());
+  rig.board.set_input("DIO1", 1);
+  rig.run_ms(100);
+  EXPECT_EQ(rig.gap(3, 2), 0);
+  EXPECT_EQ(rig.gap(1, 2), 5000);
+}
+
 }  // namespace
 }  // namespace motwin::testing

@@ -26,6 +26,9 @@ void Tmcm3216TmclAxis::reset_state() {
   home_search_ = cia402::Homing{};
   search_final_move_ = false;
   deviation_exceeded_ = false;
+  start_pending_ = false;
+  compare_started_ = false;
+  compare_pulse_remaining_us_ = 0;
   stepper.reset();
 }
 
@@ -47,7 +50,11 @@ tmcl::Status Tmcm3216TmclAxis::set_target_velocity(int32_t velocity_pps) {
                                motion::EightPointConfigError::kNone) {
     return tmcl::Status::kInvalidValue;
   }
-  if (velocity_pps != 0) start_motion();
+  if (velocity_pps != 0) {
+    start_motion();
+  } else {
+    start_pending_ = false;  // MST: nothing left to start
+  }
   state.target_velocity = velocity_pps;
   ramp_.set_velocity_target(velocity_pps);
   return tmcl::Status::kOk;
@@ -56,6 +63,44 @@ tmcl::Status Tmcm3216TmclAxis::set_target_velocity(int32_t velocity_pps) {
 void Tmcm3216TmclAxis::start_motion() {
   stepper.clear_stall();
   if (search_ != SearchKind::kNone) end_search(false, 0);
+  start_pending_ = config.motion_start_input_mask != 0;
+}
+
+namespace {
+// The compare interval of `position`: which repeat the point lies in, rounded towards the
+// direction of motion so that a point counts when reached moving up and when left moving down.
+int64_t compare_interval(int64_t position, int64_t first, int64_t repeat, bool rising) {
+  const int64_t offset = position - first;
+  if (rising) return offset >= 0 ? offset / repeat : -((-offset + repeat - 1) / repeat);
+  return offset >= 0 ? (offset + repeat - 1) / repeat : -(-offset / repeat);
+}
+}  // namespace
+
+void Tmcm3216TmclAxis::run_position_compare(uint32_t dt_us) {
+  compare_pulse_remaining_us_ = compare_pulse_remaining_us_ > dt_us ? compare_pulse_remaining_us_ - dt_us : 0;
+  const int32_t position = ramp_.position();
+  if (!compare_started_) {
+    compare_started_ = true;
+    last_compare_position_ = position;
+    return;
+  }
+  const int64_t last = last_compare_position_;
+  const int64_t now = position;
+  last_compare_position_ = position;
+  if (now == last || config.compare_output_mask == 0) return;
+  const int64_t first = config.compare_position;
+  bool passed = false;
+  if (config.compare_repeat <= 0) {
+    passed = (last < first && now >= first) || (last > first && now <= first);
+  } else {
+    const bool rising = now > last;
+    passed = compare_interval(last, first, config.compare_repeat, rising) !=
+             compare_interval(now, first, config.compare_repeat, rising);
+  }
+  if (passed) {
+    const uint32_t length_us = static_cast<uint32_t>(config.compare_pulse_length_ms) * 1000u;
+    compare_pulse_remaining_us_ = length_us > dt_us ? length_us : dt_us;
+  }
 }
 
 int32_t Tmcm3216TmclAxis::relative_move_origin() const {
@@ -214,6 +259,7 @@ void Tmcm3216TmclAxis::run_home_search() {
 void Tmcm3216TmclAxis::set_actual_position(int32_t position) {
   ramp_.set_position(position);
   last_ramp_position_ = position;  // the motor does not move
+  last_compare_position_ = position;  // nor is a compare point passed
   if (ramp_.mode() == motion::EightPointRamp::Mode::kPosition) state.target_position = position;
 }
 
@@ -294,8 +340,9 @@ bool Tmcm3216TmclAxis::stop_on_fault(int direction) {
   return exceeded && direction != 0;
 }
 
-void Tmcm3216TmclAxis::tick(board::StepperPowerStage& stage, uint32_t dt_us) {
+void Tmcm3216TmclAxis::tick(board::StepperPowerStage& stage, uint32_t dt_us, uint8_t input_levels) {
   read_switches();  // the levels the stepper read in the last tick
+  if (start_pending_ && (input_levels & config.motion_start_input_mask) != 0) start_pending_ = false;
   run_reference_search();
   const int direction = direction_of_motion();
   if (stop_on_fault(direction)) {
@@ -310,9 +357,10 @@ void Tmcm3216TmclAxis::tick(board::StepperPowerStage& stage, uint32_t dt_us) {
     } else {
       ramp_.halt();  // hard stop, as the driver chip's stop switch input does
     }
-  } else {
+  } else if (!start_pending_) {
     ramp_.step(ramp_config(), static_cast<double>(dt_us) * 1e-6);
   }
+  run_position_compare(dt_us);
 
   // The motor follows the ramp's change, reversed by AP 251.
   const uint32_t change = static_cast<uint32_t>(ramp_.position()) - static_cast<uint32_t>(last_ramp_position_);

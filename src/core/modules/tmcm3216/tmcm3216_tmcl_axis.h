@@ -46,6 +46,12 @@ struct TmclAxisConfig {
   int32_t virtual_stop_encoder_mode = 0;      // AP 42: 1 = the stops compare the encoder position (AP 209)
   int32_t max_encoder_deviation = 0;          // AP 212: µsteps between AP 1 and AP 209 that stop the axis (0: off)
   int32_t reverse_shaft = 0;                  // AP 251: 1 = the motor turns the other way for the same moves
+  int32_t compare_position = 0;               // AP 43: µsteps, the first compare point
+  int32_t compare_repeat = 0;                 // AP 44: µsteps between compare points (0: one point)
+  int32_t compare_output_mask = 0;            // AP 45: OUT0..OUT3 pulsed at each compare point (0: off)
+  int32_t compare_pulse_length_ms = 1;        // AP 46: 0 = one control tick
+  int32_t target_reached_output_mask = 0;     // AP 47: OUT0..OUT3 high while AP 8 reads 1
+  int32_t motion_start_input_mask = 0;        // AP 48: IN0..IN3; a new move waits for one of them high
   int32_t relative_positioning_option = 0;    // AP 127: MVP REL from 0 the last target, 1 AP 1, 2 AP 209
   int32_t reference_search_mode = 1;          // AP 193: 1..10, +64 (1..4: the right switch), +128 (5..8)
   int32_t reference_search_speed_pps = 0;     // AP 194: the fast search for the switch (6099 sub 1)
@@ -109,8 +115,20 @@ class Tmcm3216TmclAxis {
   TmclAxisState state;
   Tmcm3216Stepper stepper;
 
-  // One tick on the axis' power stage.
-  void tick(board::StepperPowerStage& stage, uint32_t dt_us);
+  // One tick on the axis' power stage; `input_levels`: IN0..IN3 (bits 0..3) for AP 48.
+  void tick(board::StepperPowerStage& stage, uint32_t dt_us, uint8_t input_levels = 0);
+  // The outputs the axis drives (AP 45, 47: bits 0..3 = OUT0..OUT3) and their levels now.
+  uint8_t driven_outputs() const {
+    return static_cast<uint8_t>((config.compare_output_mask | config.target_reached_output_mask) & 0x0F);
+  }
+  uint8_t output_levels() const {
+    uint8_t levels = 0;
+    if (compare_pulse_remaining_us_ > 0) levels |= static_cast<uint8_t>(config.compare_output_mask);
+    if (position_reached()) levels |= static_cast<uint8_t>(config.target_reached_output_mask);
+    return static_cast<uint8_t>(levels & 0x0F);
+  }
+  // AP 48: a move accepted but held until a masked input is high.
+  bool motion_start_pending() const { return start_pending_; }
 
   // TMCL module base: power-up clears the live state (settings are restored after).
   void reset_state();
@@ -151,8 +169,11 @@ class Tmcm3216TmclAxis {
   // A stall (AP 181) or an encoder deviation (AP 212) that stops the axis, moving in `direction`
   // (0: at rest), at once.
   bool stop_on_fault(int direction);
-  // A new move clears what stopped the last one (a stall) and ends a reference search.
+  // A new move clears what stopped the last one (a stall) and ends a reference search; with AP 48
+  // set it waits for its input.
   void start_motion();
+  // AP 43..46: a pulse when the position passes a compare point this tick.
+  void run_position_compare(uint32_t dt_us);
   // One tick of the reference search: the state machine's command carried out on the ramp.
   void run_reference_search();
   void run_switch_search();
@@ -172,6 +193,10 @@ class Tmcm3216TmclAxis {
   bool search_final_move_ = false;  // to the reference point at the slow speed
   double search_velocity_limit_pps_ = 0.0;
   bool deviation_exceeded_ = false;  // AP 207 bit 1 is set when the deviation starts
+  bool start_pending_ = false;       // AP 48
+  bool compare_started_ = false;
+  int32_t last_compare_position_ = 0;
+  uint32_t compare_pulse_remaining_us_ = 0;
   // The motor's side of AP 251: the ramp's position changes, reversed or not, summed; the stepper
   // follows this, so that turning AP 251 over moves nothing.
   int32_t last_ramp_position_ = 0;
