@@ -105,15 +105,17 @@ RigHandle<Rig> fresh_rig() {
 using Tmcm1636 = modules::tmcm1636::Tmcm1636;
 using Tmcm1636Nvm = board::RamNonVolatileMemory<Tmcm1636::kNvmLayout.total_size>;
 
-// Every readable parameter of bank 0 and every axis parameter, as GAP/GGP see them, plus banks
-// 1..3 (user variables and the module's banks).
+// Every readable parameter of bank 0 and every axis parameter of every motor, as GAP/GGP see
+// them, plus banks 1..3 (user variables and the module's banks).
 template <typename Module>
 std::vector<int32_t> probe_parameters(Module& module) {
   std::vector<int32_t> values;
-  for (const auto& row : module.axis_table().rows()) {
-    int32_t value = 0;
-    const auto status = module.get_axis_parameter(static_cast<uint8_t>(row.info.number), 0, value);
-    values.push_back(static_cast<int32_t>(status) * 7919 + value);
+  for (uint8_t motor = 0; motor < Module::kMotorCount; ++motor) {
+    for (const auto& row : module.axis_table().rows()) {
+      int32_t value = 0;
+      const auto status = module.get_axis_parameter(static_cast<uint8_t>(row.info.number), motor, value);
+      values.push_back(static_cast<int32_t>(status) * 7919 + value);
+    }
   }
   for (const auto& row : Module::global_parameters().rows()) {
     int32_t value = 0;
@@ -153,7 +155,7 @@ struct Tmcm1636Rig {
   std::vector<int32_t> state() { return module_state(module, nvm); }
 };
 
-// A writable axis parameter (motor 0) holds a value inside its row's range, whatever came before.
+// A writable axis parameter (of every motor) holds a value inside its row's range, whatever came before.
 // The rows' getters are called directly, as get_axis_parameter() does after finding the row (a
 // search per parameter cost about half of each input's time).
 template <typename Module>
@@ -163,10 +165,12 @@ FUZZ_UNTRACED void check_axis_parameter_ranges(Module& module, const char* when)
         row.binding.get == nullptr) {
       continue;
     }
-    const int32_t value = row.binding.get(module, 0);
-    FUZZ_CHECK(params::in_range(row.info, value), "%s: AP %u (%.*s) holds %d, range %lld..%lld", when,
-               row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), value,
-               static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
+    for (uint8_t motor = 0; motor < Module::kMotorCount; ++motor) {
+      const int32_t value = row.binding.get(module, motor);
+      FUZZ_CHECK(params::in_range(row.info, value), "%s: AP %u (%.*s) of motor %u holds %d, range %lld..%lld", when,
+                 row.info.number, static_cast<int>(row.info.name.size()), row.info.name.data(), motor, value,
+                 static_cast<long long>(row.info.min), static_cast<long long>(row.info.max));
+    }
   }
 }
 
@@ -185,7 +189,7 @@ FUZZ_UNTRACED void check_global_parameter_ranges(Module& module, const char* whe
   }
 }
 
-// A TMCL module (TMCM-1636, TMCM-142): every writable parameter within its range.
+// A TMCL module (TMCM-1636, TMCM-142, TMCM-3216 TMCL): every writable parameter within its range.
 template <typename Module>
 void check_parameter_ranges(Module& module, const char* when) {
   check_axis_parameter_ranges(module, when);

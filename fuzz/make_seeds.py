@@ -215,6 +215,15 @@ def tmcl_engine_seeds():
                                   (9, 66, 0), (10, 66, 0), (7, 4, 0), (8, 4, 0), (9, 84, 1), (11, 84, 0)):
         instruction(f, command, type_, 0, value)
     write("tmcl_engine", "limits", f.data())
+    for name, text in TMCL_ENGINE_FINDINGS:
+        write("tmcl_engine", name, base64.b64decode(text))
+
+
+# 2026-12-08: the engine's device entry points indexed the axes with a motor beyond the last
+# (fuzz/README.md "Findings").
+TMCL_ENGINE_FINDINGS = [
+    ("finding_2026_12_08_axis_parameter_of_motor_4", "AAAAgAUBAIAAAY8BAI8BAI8BAI8BAI8BFgABCgAAgAUBADsAGwHQBwCABQEABAAB6AMAgAT6BAAFAAEAAACABQEAhAAB"),
+]
 
 
 def tmcl_can_frame_seeds():
@@ -799,6 +808,11 @@ def engine_seeds():
         write("tmcm3216_drive", name, base64.b64decode(text))
     for name, text in TMCM142_ENGINE_FINDINGS:
         write("tmcm142_engine", name, base64.b64decode(text))
+    # The TMCM-3216 TMCL engine: a generator of its own, so that the seeds above stay as they are.
+    rng_tmcl3216 = random.Random(3216)
+    for n in (64, 256, 1024, 4096):
+        for k in range(2):
+            write("tmcm3216_tmcl_engine", f"random_{n}_{k}", bytes(rng_tmcl3216.randrange(256) for _ in range(n)))
     # tmcm3216_drive's last byte is its bring-up: bits 0-2 the axes enabled, 3-5 the mode
     # (pp, pv, hm, csp, csv, ...), 6 no NMT start, 7 limit switches off (2005 = 3).
     for bring_up in (0x07, 0x0F, 0x17, 0x1F, 0x27, 0x81, 0x89, 0x91, 0x99, 0xA1, 0xC7):

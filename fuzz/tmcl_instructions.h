@@ -49,7 +49,9 @@ tmcl::Instruction next_instruction(FuzzedDataProvider& in) {
   } else {
     instruction.type = in.ConsumeIntegral<uint8_t>();
   }
-  instruction.motor_bank = in.ConsumeBool() ? 0 : in.ConsumeIntegral<uint8_t>();
+  // Mostly a motor the module has (no bytes drawn for a one-motor module, as before).
+  instruction.motor_bank = in.ConsumeBool() ? in.ConsumeIntegralInRange<uint8_t>(0, Module::kMotorCount - 1)
+                                            : in.ConsumeIntegral<uint8_t>();
   instruction.value = interesting_value(in, info);
   return instruction;
 }

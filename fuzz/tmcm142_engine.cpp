@@ -17,7 +17,7 @@
 #include <memory>
 
 #include "fuzz_support.h"
-#include "tmcl_instructions.h"
+#include "tmcl_module_engine.h"
 #include "tmcm142_rig.h"
 
 namespace {
@@ -39,24 +39,12 @@ void check_motor(Rig& rig) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   FuzzedDataProvider in(data, size);
   auto rig = fuzz::fresh_rig<Rig>();
-  tmcl::TmclEngine& engine = rig->engine();
   // 50 ms of motion per input at most, in batches of up to 5 ms (fuzz/README.md, Decisions).
-  int ticks_left = 1'000;
-  for (int step = 0; step < 256 && in.remaining_bytes() > 0; ++step) {
-    if (in.ConsumeIntegralInRange<int>(0, 5) == 0) {
-      const int ticks = in.ConsumeIntegralInRange<int>(1, 100);
-      for (int t = 0; t < ticks && ticks_left > 0; ++t, --ticks_left) rig->tick();
-      fuzz::check_parameter_ranges(*rig->module, "after ticks");
-      check_motor(*rig);
-      continue;
-    }
-    const tmcl::Instruction instruction = fuzz::next_instruction<Tmcm142>(in);
-    // GP 133 (random number) reads a new value each time, AP 44 and 207 are cleared by reading and
-    // GP 131 (last TMCL error) records the refusal itself: no "unchanged" to compare.
-    const bool is_set = (instruction.command == 5 && instruction.type != 44 && instruction.type != 207) ||
-                        (instruction.command == 9 && instruction.type != 133 && instruction.type != 131);
-    fuzz::execute_checked(*rig->module, engine, instruction, is_set);
-    fuzz::check_parameter_ranges(*rig->module, "after an instruction");
-  }
+  // GP 133 (random number) reads a new value each time, AP 44 and 207 are cleared by reading and
+  // GP 131 (last TMCL error) records the refusal itself: no "unchanged" to compare.
+  fuzz::run_module_engine<Tmcm142>(in, *rig, {1'000, 100}, check_motor, [](const tmcl::Instruction& instruction) {
+    return (instruction.command == 5 && instruction.type != 44 && instruction.type != 207) ||
+           (instruction.command == 9 && instruction.type != 133 && instruction.type != 131);
+  });
   return 0;
 }
