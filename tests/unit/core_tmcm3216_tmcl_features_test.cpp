@@ -459,5 +459,41 @@ TEST(Tmcm3216TmclFeatures, a_move_waits_for_the_motion_start_input) {
   EXPECT_EQ(rig.gap(1, 2), 5000);
 }
 
+// The datalogger (command 142) samples any motor's parameters: AP 1 and AP 3 of motor 2 turning
+// at 20000 pps, 2 kHz rows: AP 1 advances exactly 10 µsteps a row.
+TEST(Tmcm3216TmclFeatures, the_datalogger_samples_a_parameter_of_any_motor) {
+  Tmcm3216TmclRig rig;
+  constexpr uint8_t kRamDebug = 142;
+  namespace op = tmcl::ram_debug::op;
+  const auto ok = [&](uint8_t type, uint8_t motor, int32_t value) {
+    const tmcl::Reply reply = rig.command(kRamDebug, type, motor, value);
+    EXPECT_EQ(reply.status, 100) << "142 type " << int{type};
+    return reply.value;
+  };
+  EXPECT_EQ(ok(op::kGetInfo, 0, 2), 2000) << "base rate";
+  EXPECT_EQ(ok(op::kGetInfo, 0, 0), 4) << "channels";
+  ASSERT_EQ(rig.command(kRor, 0, 2, 20000).status, 100);
+  rig.run_ms(600);
+  ASSERT_EQ(rig.gap(3, 2), 20000);
+  ok(op::kInit, 0, 0);
+  ok(op::kSetSampleCount, 0, 20);
+  ok(op::kSetPrescaler, 0, 0);
+  ok(op::kSetChannel, tmcl::ram_debug::channel_type::kAxisParameter, (2 << 24) | 1);
+  ok(op::kSetChannel, tmcl::ram_debug::channel_type::kAxisParameter, (2 << 24) | 3);
+  EXPECT_EQ(rig.command(kRamDebug, op::kSetChannel, tmcl::ram_debug::channel_type::kAxisParameter, (3 << 24) | 1).status, 4)
+      << "no motor 3";
+  ok(op::kEnableTrigger, 0, 0);
+  for (int t = 0; t < 1000 && ok(op::kGetState, 0, 0) != static_cast<int32_t>(tmcl::ram_debug::State::kComplete); ++t) {
+    rig.tick();
+  }
+  ASSERT_EQ(ok(op::kGetState, 0, 0), static_cast<int32_t>(tmcl::ram_debug::State::kComplete));
+  for (int32_t row = 0; row < 10; ++row) {
+    EXPECT_EQ(ok(op::kGetSample, 0, 2 * row + 1), 20000) << "AP 3, row " << row;
+    if (row > 0) {
+      EXPECT_EQ(ok(op::kGetSample, 0, 2 * row) - ok(op::kGetSample, 0, 2 * row - 2), 10) << "row " << row;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace motwin::testing

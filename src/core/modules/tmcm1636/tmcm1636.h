@@ -21,6 +21,7 @@
 #include "core/tmcl/module_storage.h"
 #include "core/tmcl/nvm_layout.h"
 #include "core/tmcl/program_memory.h"
+#include "core/tmcl/module_datalogger.h"
 #include "core/tmcl/ramdebug.h"
 #include "core/tmcl/tmcl_module.h"
 
@@ -77,8 +78,7 @@ inline constexpr tmcl::ModuleFacts kFacts{
 // from tmcl::TmclModule, the parameter commands, storage and power-up from tmcl::ModuleStorage;
 // the module adds its tables, the tick of its axis and the datalogger (commands 142 and 157, in
 // both firmware generations: docs/datalogger.md).
-class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts>,
-                       public tmcl::RamDebugChannels {
+class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalConfig, board::Tmcm1636Io, kFacts> {
  public:
   Tmcm1636(board::NonVolatileMemory& nvm, board::Tmcm1636Io& io, Firmware firmware = Firmware::kV109)
       : TmclModule(nvm, io), firmware_(firmware), axis_table_(&axis_parameters(firmware)) {
@@ -111,33 +111,26 @@ class Tmcm1636 final : public tmcl::TmclModule<Tmcm1636, Tmcm1636Axis, GlobalCon
   // what this tick computed.
   void tick_axis() {
     axis().tick(io(), static_cast<double>(kControlTickUs) * 1e-6);
-    ram_debug_.control_tick();
+    datalogger_.control_tick();
   }
 
   // tmcl::ModuleStorage hooks.
   void clear_ram_state() {
     TmclModule::clear_ram_state();
-    ram_debug_.init();
+    datalogger_.init();
   }
   void after_axis_restore() { axis().finish_restore(); }  // later writes are host commands
 
   // TmclDevice: commands 142 and 157.
   tmcl::Status ram_debug(uint8_t type, uint8_t motor, int32_t& value) override {
-    return ram_debug_.execute(type, motor, value);
+    return datalogger_.ram_debug().execute(type, motor, value);
   }
   tmcl::Status get_info(uint8_t type, uint8_t /*motor*/, int32_t& value) override { return firmware_info(type, value); }
-
-  // tmcl::RamDebugChannels: axis and global parameters through the tables.
-  tmcl::Status resolve_ram_debug_channel(uint8_t type, uint32_t select, tmcl::RamDebugProbe& probe) override {
-    return resolve_parameter_channel(type, select, probe);
-  }
-  int32_t read_ram_debug_channel(const tmcl::RamDebugProbe& probe) override { return read_parameter_channel(probe); }
 
  private:
   Firmware firmware_;
   const Table* axis_table_;
-  std::array<uint32_t, kRamDebugBufferWords> ram_debug_buffer_{};
-  tmcl::RamDebug ram_debug_{*this, kRamDebugConfig, ram_debug_buffer_};
+  tmcl::ModuleDatalogger<Tmcm1636, kRamDebugBufferWords> datalogger_{*this, kRamDebugConfig};
 };
 
 }  // namespace motwin::modules::tmcm1636

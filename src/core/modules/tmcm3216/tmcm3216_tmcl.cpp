@@ -23,6 +23,7 @@ void Tmcm3216Tmcl::tick_axis() {
   for (uint8_t port = 0; port < board::Tmcm3216Io::kDioCount; ++port) {
     if ((driven & (1u << port)) != 0) io_adapter_.set_digital_output(port, (levels & (1u << port)) != 0);
   }
+  datalogger_.control_tick();
 }
 
 }  // namespace motwin::modules::tmcm3216

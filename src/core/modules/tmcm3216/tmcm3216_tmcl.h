@@ -13,6 +13,7 @@
 #include "board/modules/tmcm3216/tmcm3216_board.h"
 #include "core/modules/tmcm3216/tmcm3216_hardware.h"
 #include "core/modules/tmcm3216/tmcm3216_tmcl_axis.h"
+#include "core/tmcl/module_datalogger.h"
 #include "core/tmcl/tmcl_module.h"
 
 namespace motwin::modules::tmcm3216 {
@@ -67,6 +68,14 @@ class Tmcm3216TmclIo {
 inline constexpr size_t kTmclStorableUserVariables = 56;  // as the TMCM-142 (docs "Decisions")
 inline constexpr size_t kTmclProgramCapacity = 2048;
 
+// The datalogger (commands 142, 157) as the TMCM-1636's [Motwin decision: PyTrinamic's RAMDebug
+// talks to any TMCL module that answers 142]: 4 channels at 2 kHz (every 10th control tick), a
+// buffer of 8192 words.
+inline constexpr uint32_t kTmclRamDebugBaseRateHz = 2000;
+inline constexpr size_t kTmclRamDebugBufferWords = 8192;
+inline constexpr tmcl::RamDebugConfig kTmclRamDebugConfig{4, kTmclRamDebugBaseRateHz,
+                                                          1'000'000 / kTickUs / kTmclRamDebugBaseRateHz};
+
 inline constexpr tmcl::ModuleFacts kTmclFacts{
     .name = "tmcm-3216",
     .identity = {3216, 1, 0, "3216V100"},
@@ -86,8 +95,19 @@ class Tmcm3216Tmcl final
   static const Table& axis_parameters();
   static const Table& global_parameters();  // bank 0
 
-  // tmcl::TmclModule hook: one 50 µs tick of the three axes, and the brake outputs they drive.
+  // tmcl::TmclModule hook: one 50 µs tick of the three axes, the outputs they drive, then the
+  // datalogger samples what this tick computed.
   void tick_axis();
+  // tmcl::ModuleStorage hook: power-up also stops the datalogger.
+  void clear_ram_state() {
+    TmclModule::clear_ram_state();
+    datalogger_.init();
+  }
+
+  // TmclDevice: command 142.
+  tmcl::Status ram_debug(uint8_t type, uint8_t motor, int32_t& value) override {
+    return datalogger_.ram_debug().execute(type, motor, value);
+  }
 
   // TmclDevice: PyTrinamic's GP3 list names vectors 39..42 Input_0..3, which are GIO ports 2..5.
   uint8_t first_interrupt_input_port() const override { return 2; }
@@ -97,6 +117,7 @@ class Tmcm3216Tmcl final
  private:
   board::Tmcm3216Board& board_;
   Tmcm3216TmclIo io_adapter_;
+  tmcl::ModuleDatalogger<Tmcm3216Tmcl, kTmclRamDebugBufferWords> datalogger_{*this, kTmclRamDebugConfig};
 };
 
 }  // namespace motwin::modules::tmcm3216
