@@ -519,7 +519,7 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
     if (runtime.has_tmcl_service()) {
       targets.push_back(tools::web::tmcl_target(module.descriptor, std::string(single.name()),
                                                 std::string(single.firmware_version()), module.options.firmware,
-                                                &runtime.service()));
+                                                served.module->engine().device().motor_count(), &runtime.service()));
     } else {
       targets.push_back(tools::web::canopen_target(module.descriptor, std::string(single.name()),
                                                    std::string(single.firmware_version()),
@@ -539,7 +539,11 @@ Result<OpenEndpoint> open_web_endpoint(host::HostRuntime& runtime, ServedCanBus&
       targets.push_back(descriptor.canopen != nullptr
                             ? tools::web::canopen_target(descriptor, member.name, firmware,
                                                          configured_node_id(spec.node_id))
-                            : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware, nullptr,
+                            : tools::web::tmcl_target(descriptor, member.name, firmware, spec.firmware,
+                                                      member.module->has_tmcl()
+                                                          ? member.module->engine().device().motor_count()
+                                                          : uint8_t{1},
+                                                      nullptr,
                                                       bus != nullptr ? member.module->tmcl_can_node() : nullptr));
       targets.back().world.board = &member.module->signals();  // read only: a node takes no scenario
     }

@@ -45,6 +45,10 @@ def test_parameters_and_console(motwin):
         # A live value: what the module holds, then what a TMCL host changes it to.
         before = tmcl.gap(MAX_CURRENT)
         browser.wait("the live value of AP 11", lambda: browser.value_of(key) == str(before))
+        # One motor: no motor to choose, the rows as they always were.
+        check(not browser.find("#motor-pick").is_displayed(), "no motor selector on a module of one motor")
+        check_equal([tr.get_attribute("data-key") for tr in browser.finds("#parameters tbody tr[data-key*='@']")], [],
+                    "rows of another motor")
         tmcl.sap(MAX_CURRENT, 1234)
         browser.wait("the live value to follow SAP over TCP", lambda: browser.value_of(key) == "1234")
 
@@ -108,6 +112,74 @@ def test_parameters_and_console(motwin):
         browser.wait("the narrow layout", lambda: browser.driver.execute_script(
             "return document.documentElement.scrollWidth <= window.innerWidth + 1"))
         browser.screenshot(motwin, "parameters-narrow")
+        browser.check_log_clean()
+        server.stop()
+
+
+MAX_VELOCITY = 4  # TMCM-3216 TMCL axis parameter, per motor
+
+
+def choose_motor(browser, select_id, motor):
+    Select(browser.find(select_id)).select_by_value(str(motor))
+
+
+def test_three_motors(motwin):
+    """The TMCM-3216's TMCL firmware, three motors: the Parameters view's motor selector shows and
+    edits AP 4 of the motor chosen (checked over TMCL/TCP), the Scope picks curves of two motors."""
+    with bh.browser_and_server(Browser, wh.WebTmcm3216TmclServer, motwin) as (browser, server), \
+            TcpClient(server.tcp_port) as tmcl:
+        for motor, value in enumerate((11111, 22222, 33333)):
+            tmcl.sap(MAX_VELOCITY, value, motor=motor)
+        browser.open_console(server.url("/"))
+        browser.wait("motor 0's AP 4", lambda: browser.value_of("a4") == "11111")
+        check(browser.find("#motor-pick").is_displayed(), "the motor selector of a module of three motors")
+        check_equal([option.text for option in Select(browser.find("#motor-picker")).options], ["0", "1", "2"],
+                    "the motors offered")
+        check_equal(browser.finds('#parameters input[data-key="a4@1"]'), [], "motor 1's rows before it is chosen")
+
+        # Motor 1: its values, live; a SAP of motor 1 over TCP shows, motor 0's rows are gone.
+        choose_motor(browser, "#motor-picker", 1)
+        browser.wait("motor 1's AP 4", lambda: browser.value_of("a4@1") == "22222")
+        check_equal(browser.finds('#parameters input[data-key="a4"]'), [], "motor 0's AP 4 with motor 1 chosen")
+        check("motor 1" in browser.find("#parameters tbody tr.section th").text, "the section names the motor")
+        tmcl.sap(MAX_VELOCITY, 22223, motor=1)
+        browser.wait("motor 1's AP 4 to follow SAP 4, 1 over TCP", lambda: browser.value_of("a4@1") == "22223")
+        browser.screenshot(motwin, "parameters-motor")
+
+        # Motor 2: an edit in the table reaches motor 2 alone.
+        choose_motor(browser, "#motor-picker", 2)
+        browser.wait("motor 2's AP 4", lambda: browser.value_of("a4@2") == "33333")
+        field = browser.find('input[data-key="a4@2"]')
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys("44444", Keys.ENTER)
+        browser.wait("the reply to 44444", lambda: browser.reply_of("a4@2").startswith("100"))
+        check_equal([tmcl.gap(MAX_VELOCITY, motor) for motor in range(3)], [11111, 22223, 44444],
+                    "AP 4 of motors 0..2 over TCP after the page set motor 2's")
+
+        # The Scope: AP 4 of motor 2 and of motor 0, each under its motor.
+        browser.show("scope")
+        browser.wait("the scope's motor selector", lambda: browser.find("#scope-motor-pick").is_displayed())
+        choose_motor(browser, "#scope-motor", 2)
+        browser.wait("motor 2's curves", lambda: browser.finds('#scope-choices input[data-key="a4@2"]') != [])
+        browser.find('#scope-choices input[data-key="a4@2"]').click()
+        choose_motor(browser, "#scope-motor", 0)
+        browser.wait("motor 0's curves", lambda: browser.finds('#scope-choices input[data-key="a4"]') != [])
+        check(browser.find('#scope-choices input[data-key="a4@2"]').is_selected(), "the picked curve of motor 2 stays")
+        browser.find('#scope-choices input[data-key="a4"]').click()
+        browser.find("#scope-start").click()
+        browser.wait("the scope to plot updates", lambda: scope_pushes(browser) >= 3)
+        check_equal(scope_js(browser, "scope.series.map(s => s.name)"), ["AP4_m2", "AP4_m0"], "the curves' names")
+        last = scope_js(browser, "scope.uplot.data.slice(1).map(c => c[c.length - 1])")
+        check_equal(last, [44444, 11111], "the curves' values: motor 2's and motor 0's AP 4")
+        browser.screenshot(motwin, "scope-motors")
+        browser.find("#scope-stop").click()
+        browser.wait("Stop", lambda: not browser.driver.execute_script("return window.motwinConsole.scopeRunning;"))
+
+        # The World view: an axis drawn per motor.
+        browser.show("world")
+        browser.wait("three axes drawn", lambda: len(browser.finds("#world-axes figure.world-axis")) == 3)
+        browser.show("parameters")
         browser.check_log_clean()
         server.stop()
 
@@ -459,5 +531,5 @@ def test_canopen_view(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_parameters_and_console, test_scope, test_scope_module_switch, test_canopen_node,
+    run_tests([test_parameters_and_console, test_three_motors, test_scope, test_scope_module_switch, test_canopen_node,
                test_canopen_view])

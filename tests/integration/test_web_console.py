@@ -41,7 +41,8 @@ def test_parameters_through_the_modules_checks(motwin):
         listing = console.ask("list")
         check_equal(listing["ok"], True, "list")
         module = listing["modules"][0]
-        check_equal((module["name"], module["protocol"]), ("tmcm-1636", "tmcl"), "the listed module")
+        check_equal((module["name"], module["protocol"], module["motors"]), ("tmcm-1636", "tmcl", 1),
+                    "the listed module")
         row = next(p for p in module["sections"][0]["parameters"] if p["number"] == MAX_CURRENT)
         check_equal((row["min"], row["max"], row["unit"], row["access"]), (0, 60000, "mA", "RWEX"), "row of AP 11")
 
@@ -68,6 +69,44 @@ def test_parameters_through_the_modules_checks(motwin):
         check_equal(tmcl.gap(MAX_CURRENT), 1800, "AP 11 after the console's SAP")
         check_equal(console.ask("tmcl", module=0, text="136 0")["version"], "1636V109", "version string")
         check_equal(console.ask("store", module=0, number=MAX_CURRENT)["status"], 100, "store (STAP)")
+        server.stop()
+
+
+MAX_VELOCITY = 4  # TMCM-3216 TMCL axis parameter, per motor: 0..16777215 pps
+
+
+def test_three_motors(motwin):
+    """The TMCM-3216's TMCL firmware: AP 4 of each motor through the console's `axis` field, checked
+    against GAP/SAP of the same motor over TMCL/TCP; a motor beyond the last refused."""
+    wh.require_websocket()
+    with TempDir() as state, wh.WebTmcm3216TmclServer(motwin, state).start() as server, \
+            TcpClient(server.tcp_port) as tmcl, server.console() as console:
+        module = console.ask("list")["modules"][0]
+        check_equal((module["name"], module["protocol"], module["firmware"], module["motors"]),
+                    ("tmcm-3216", "tmcl", "3216V100", 3), "the listed module")
+        before = [tmcl.gap(MAX_VELOCITY, motor) for motor in range(3)]
+        # The console writes motor 2; a TMCL host reads it there, motors 0 and 1 as they were.
+        reply = console.ask("set", module=0, kind="axis", number=MAX_VELOCITY, axis=2, value=12345)
+        check_equal((reply["ok"], reply["status"]), (True, 100), "set AP 4 of motor 2")
+        check_equal([tmcl.gap(MAX_VELOCITY, motor) for motor in range(3)], [before[0], before[1], 12345],
+                    "GAP 4 of motors 0..2 over TCP after the console's set")
+        # A TMCL host writes motor 1; the console reads it there.
+        tmcl.sap(MAX_VELOCITY, 23456, motor=1)
+        check_equal([console.ask("get", module=0, number=MAX_VELOCITY, axis=motor)["value"] for motor in range(3)],
+                    [before[0], 23456, 12345], "get of AP 4 of motors 0..2 after SAP 4, 1 over TCP")
+        # Subscribed per motor: each item echoes its axis and has its motor's value.
+        reply = console.ask("subscribe", rate_hz=25, items=[
+            {"module": 0, "kind": "axis", "number": MAX_VELOCITY, "axis": motor} for motor in range(3)])
+        check_equal(reply["ok"], True, "subscribe to AP 4 of each motor")
+        values = console.next_update()["values"]
+        check_equal([(v["axis"], v["value"]) for v in values], [(0, before[0]), (1, 23456), (2, 12345)],
+                    "the update's values per motor")
+        console.ask("unsubscribe")
+        # Motor 3: the console refuses it, naming the motors; the firmware answers a host status 4.
+        reply = console.ask("set", module=0, number=MAX_VELOCITY, axis=3, value=1)
+        check_equal((reply["ok"], reply.get("error")),
+                    (False, '"axis": no motor 3 on tmcm-3216 (3 motors: 0..2)'), "set of motor 3")
+        check_equal(tmcl.request(mh.GAP, MAX_VELOCITY, 3).status, 4, "GAP 4, 3 over TCP: invalid value")
         server.stop()
 
 
@@ -156,5 +195,6 @@ def test_canopen_node(motwin):
 
 
 if __name__ == "__main__":
-    run_tests([test_http_files_and_loopback, test_parameters_through_the_modules_checks, test_subscription_updates,
+    run_tests([test_http_files_and_loopback, test_parameters_through_the_modules_checks, test_three_motors,
+               test_subscription_updates,
                test_garbage_leaves_connection_and_module_intact, test_token_and_non_loopback, test_canopen_node])

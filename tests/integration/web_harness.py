@@ -39,6 +39,16 @@ class WebServer(mh.Server):
         return ConsoleClient(self.web_port, query)
 
 
+class WebTmcm3216TmclServer(WebServer):
+    """`motwin serve --module tmcm-3216 --firmware tmcl` with TMCL over TCP and the web console:
+    a TMCL module of three motors (docs/tmcm-3216-tmcl.md)."""
+
+    BANNER = r"motwin: tmcm-3216 \(3216V100\) eeprom (.+)"
+
+    def __init__(self, motwin, state_dir, extra_args=()):
+        super().__init__(motwin, state_dir, module="tmcm-3216", extra_args=["--firmware", "tmcl", *extra_args])
+
+
 class WebCanServer(CanServer):
     """`motwin serve` of a TMCM-3216 on socketcand with the web console."""
 

@@ -28,9 +28,10 @@ using motwin::testing::FakeWebConnection;
 // SDO transfer to a silent node ends after WebConsole::kSdoTimeoutUs.
 class ConsoleRig : public motwin::testing::WebConsoleRig {
  public:
-  explicit ConsoleRig(const char* module_name)
-      : WebConsoleRig(module_name,
-                      motwin::testing::WebConsoleRigSetup().with_reply_wait(motwin::testing::ReplyWait::kWallClock)) {}
+  explicit ConsoleRig(const char* module_name, const std::string& firmware = "")
+      : WebConsoleRig(module_name, motwin::testing::WebConsoleRigSetup()
+                                       .with_firmware(firmware)
+                                       .with_reply_wait(motwin::testing::ReplyWait::kWallClock)) {}
 
   void run_until_replies(size_t count) {
     for (int step = 0; step < 1000000 && connection().replies.size() < count; ++step) runtime().step(0);
@@ -254,6 +255,83 @@ TEST(WebConsole, too_many_waiting_requests_are_refused_not_queued) {
   size_t answered = 0;
   for (const Json& reply : rig.connection().replies) answered += reply["ok"] == true ? 1 : 0;
   EXPECT_EQ(answered, WebConsole::kMaxPendingRequestsPerSession + 1);
+}
+
+// --- A module of three motors: the TMCM-3216's TMCL firmware -----------------------------------
+
+TEST(WebConsole, list_says_how_many_motors_a_module_has) {
+  EXPECT_EQ(ConsoleRig("tmcm-1636").ask({{"op", "list"}})["modules"][0]["motors"], 1);
+  EXPECT_EQ(ConsoleRig("tmcm-142").ask({{"op", "list"}})["modules"][0]["motors"], 1);
+  const Json three = ConsoleRig("tmcm-3216", "tmcl").ask({{"op", "list"}})["modules"][0];
+  EXPECT_EQ(three["protocol"], "tmcl");
+  EXPECT_EQ(three["firmware"], "3216V100");
+  EXPECT_EQ(three["motors"], 3);
+  EXPECT_EQ(three["sections"][0]["kind"], "axis");  // one table, for every motor
+  // A CANopen node: the axes its dictionary lists.
+  EXPECT_EQ(ConsoleRig("tmcm-3216").ask({{"op", "list"}})["modules"][0]["motors"], 3);
+}
+
+// AP 4 (maximum positioning speed) of each motor is its own: what the console sets on motor 2 a
+// TMCL host reads there (GAP 4, 2), and the other way round, motors 0 and 1 untouched.
+TEST(WebConsole, each_motors_axis_parameters_are_read_and_written_by_the_axis_field) {
+  ConsoleRig rig("tmcm-3216", "tmcl");
+  const int64_t motor0 = rig.ask({{"op", "get"}, {"number", 4}, {"axis", 0}})["value"];
+  const int64_t motor1 = rig.ask({{"op", "get"}, {"number", 4}, {"axis", 1}})["value"];
+  Json reply = rig.ask({{"op", "set"}, {"kind", "axis"}, {"number", 4}, {"axis", 2}, {"value", 12345}});
+  EXPECT_EQ(reply["ok"], true) << reply.dump();
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 4, 2"}})["value"], 12345);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 4, 0"}})["value"], motor0);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 4, 1"}})["value"], motor1);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "SAP 4, 1, 23456"}})["status"], 100);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 4}, {"axis", 1}})["value"], 23456);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 4}, {"axis", 2}})["value"], 12345);
+  // Store and restore reach the motor asked for: STAP 4, 2 keeps 12345 through a set.
+  const Json stored = rig.ask({{"op", "store"}, {"number", 4}, {"axis", 2}});
+  EXPECT_EQ(stored["command"], 7);
+  EXPECT_EQ(stored["status"], 100);
+  rig.ask({{"op", "set"}, {"number", 4}, {"axis", 2}, {"value", 777}});
+  EXPECT_EQ(rig.ask({{"op", "restore"}, {"number", 4}, {"axis", 2}})["status"], 100);
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"number", 4}, {"axis", 2}})["value"], 12345);
+}
+
+// A motor beyond the last is refused by the console with the module's motors named, nothing
+// sent; a TMCL host's GAP 4, 3 gets status 4 (invalid value) from the firmware.
+TEST(WebConsole, a_motor_beyond_the_last_is_refused_before_anything_is_sent) {
+  ConsoleRig rig("tmcm-3216", "tmcl");
+  const uint64_t served = rig.served_tmcl_requests();
+  for (const char* op : {"get", "set", "store", "restore"}) {
+    const Json reply = rig.ask({{"op", op}, {"number", 4}, {"axis", 3}, {"value", 1}});
+    EXPECT_EQ(reply["ok"], false);
+    EXPECT_EQ(reply["error"], "\"axis\": no motor 3 on tmcm-3216 (3 motors: 0..2)") << op;
+  }
+  const Json subscribe = rig.ask({{"op", "subscribe"}, {"items", {{{"number", 4}, {"axis", 3}}}}});
+  EXPECT_EQ(subscribe["ok"], false);
+  EXPECT_EQ(subscribe["error"], "\"axis\": no motor 3 on tmcm-3216 (3 motors: 0..2)");
+  EXPECT_EQ(rig.served_tmcl_requests(), served);
+  EXPECT_EQ(rig.ask({{"op", "tmcl"}, {"text", "GAP 4, 3"}})["status"], 4);
+  // A global parameter's bank is no motor.
+  EXPECT_EQ(rig.ask({{"op", "get"}, {"kind", "global"}, {"number", 0}, {"bank", 2}})["status"], 100);
+  // One motor: axis 1 is beyond it.
+  EXPECT_EQ(ConsoleRig("tmcm-1636").ask({{"op", "get"}, {"number", 4}, {"axis", 1}})["error"],
+            "\"axis\": no motor 1 on tmcm-1636 (one motor: 0)");
+}
+
+// A subscription of the same parameter on each motor: each value its motor's, each item echoing
+// its axis (the page tells them apart by it).
+TEST(WebConsole, a_subscription_reads_each_motor_of_the_same_parameter) {
+  ConsoleRig rig("tmcm-3216", "tmcl");
+  for (int motor = 0; motor < 3; ++motor) {
+    rig.ask({{"op", "set"}, {"number", 4}, {"axis", motor}, {"value", 1000 * (motor + 1)}});
+  }
+  Json items = Json::array();
+  for (int motor = 0; motor < 3; ++motor) items.push_back({{"kind", "axis"}, {"number", 4}, {"axis", motor}});
+  ASSERT_EQ(rig.ask({{"op", "subscribe"}, {"items", items}, {"rate_hz", 50}})["ok"], true);
+  const Json push = rig.next_push();
+  ASSERT_EQ(push["values"].size(), 3u);
+  for (int motor = 0; motor < 3; ++motor) {
+    EXPECT_EQ(push["values"][motor]["axis"], motor);
+    EXPECT_EQ(push["values"][motor]["value"], 1000 * (motor + 1));
+  }
 }
 
 // --- A CANopen node -----------------------------------------------------------------------------

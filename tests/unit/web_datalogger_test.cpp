@@ -84,6 +84,11 @@ TEST(WebDatalogger, malformed_requests_are_refused_before_anything_is_sent) {
                                            {"trigger", {{"channel", 1}, {"level", 0}}}});
   EXPECT_EQ(bad_trigger["ok"], false);
   EXPECT_NE(bad_trigger["error"].get<std::string>().find("trigger"), std::string::npos);
+  // A motor the module does not have (the TMCM-1636 has one).
+  const Json no_motor = rig.datalogger(
+      {{"action", "start"}, {"channels", {{{"number", 52}}, {{"number", 42}, {"axis", 1}}}}, {"samples", 10}});
+  EXPECT_EQ(no_motor["ok"], false);
+  EXPECT_EQ(no_motor["error"], "\"axis\": no motor 1 on tmcm-1636 (one motor: 0)");
   // Nothing reached the module: it is still idle after power-up.
   EXPECT_EQ(rig.datalogger({{"action", "state"}})["state"], "idle");
 }

@@ -49,7 +49,8 @@ class CanRig : public motwin::testing::WebConsoleRig {
                                        .with_target_adapter([](WebConsoleRig& rig, ConsoleTarget& target) {
                                          target = tmcl_target(*host::find_module("tmcm-1636"), "tmcm-1636-1",
                                                               std::string(rig.module().firmware_version()), "",
-                                                              nullptr, rig.module().tmcl_can_node());
+                                                              rig.module().engine().device().motor_count(), nullptr,
+                                                              rig.module().tmcl_can_node());
                                        })) {}
 
   void run_wall_us(uint64_t wall_us) {

@@ -26,14 +26,16 @@
     waiting: new Map(),   // request id -> callback
     modules: [],
     module: 0,
-    rows: [],             // rows of the chosen module
+    motor: 0,             // the Parameters view's motor (a module of more than one)
+    rows: [],             // rows of the chosen module, the axis parameters once per motor
     shown: [],            // rows that pass the filter
-    liveKeys: [],         // keys of the rows whose values are subscribed
+    liveKeys: new Set(),  // keys of the rows whose values are subscribed
     view: "parameters",
     history: [],
     historyIndex: 0,
     scope: {
       picked: [],         // keys of the rows picked as curves, in the order picked
+      motor: 0,           // the motor whose axis parameters the picker lists
       socket: null,       // the scope's own session while it runs
       instance: null,     // the MotwinScope of the last run (kept after Stop for zoom and export)
       running: false,
@@ -46,6 +48,7 @@
     get scopeRunning() { return state.scope.running; },
     get module() { return currentModule(); },  // for the datalogger mode (datalogger.js)
     get rows() { return state.rows; },
+    get motor() { return state.motor; },
   };
 
   // --- Connection --------------------------------------------------------------------------------
@@ -134,12 +137,17 @@
       state.scope.instance.destroy();
       state.scope.instance = null;
     }
+    const sameModule = index === state.module;
     state.module = index;
     const module = currentModule();
     if (!module) return;
     $("module-info").textContent = module.product + " · firmware " + module.firmware +
       (module.protocol === "none" ? " · not reachable from the console" : "");
     $("canopen-controls").hidden = !isCanopen();
+    state.motor = sameModule ? Math.min(state.motor, motorCount(module) - 1) : 0;
+    state.scope.motor = sameModule ? Math.min(state.scope.motor, motorCount(module) - 1) : 0;
+    fillMotorPicker($("motor-picker"), $("motor-pick"), module, state.motor);
+    fillMotorPicker($("scope-motor"), $("scope-motor-pick"), module, state.scope.motor);
     state.rows = rowsOf(module);
     applyFilter();
     resetScopeChoices();
@@ -149,9 +157,37 @@
     announceView();
   }
 
-  // One table row per parameter or object entry, with the fields a request needs.
+  // The motors whose axis parameters the page addresses (TMCL motor 0..n-1; `motors` of `list`).
+  // A CANopen node's axes are objects of their own: no motor to choose.
+  function motorCount(module) {
+    if (!module || !module.sections.some((section) => section.kind === "axis")) return 1;
+    return Math.max(1, module.motors || 1);
+  }
+
+  // A motor selector, shown only for a module of more than one motor.
+  function fillMotorPicker(select, wrapper, module, motor) {
+    const count = motorCount(module);
+    select.replaceChildren();
+    for (let m = 0; m < count; m++) select.add(new Option(String(m), String(m), false, m === motor));
+    wrapper.hidden = count < 2;
+  }
+
+  // The key of a row (and of an update's entry, which echoes the row's address): motor 0's axis
+  // parameter n is "a" + n, as on a module of one motor; motor m's "a" + n + "@" + m.
+  function keyOf(address) {
+    if (address.index !== undefined) {
+      return "o" + address.index.toString(16).toUpperCase().padStart(4, "0") + "." + (address.sub || 0);
+    }
+    if (address.kind === "global") return "g" + address.bank + "." + address.number;
+    return "a" + address.number + (address.axis ? "@" + address.axis : "");
+  }
+
+  // One table row per parameter or object entry (an axis parameter once per motor), with the
+  // fields a request needs. `title` and `curveName` name the row outside the Parameters view's
+  // table (the Scope's curves, the datalogger's channels): with the motor, where there are more.
   function rowsOf(module) {
     const rows = [];
+    const motors = motorCount(module);
     for (const section of module.sections) {
       if (section.kind === "objects") {
         for (const object of section.objects) {
@@ -159,6 +195,8 @@
           rows.push({
             key: "o" + hex + "." + object.sub,
             label: hex + "." + object.sub,
+            title: hex + "." + object.sub,
+            curveName: hex + "." + object.sub,
             section: section.title,
             name: object.name,
             unit: object.type,
@@ -173,36 +211,55 @@
         continue;
       }
       const prefix = section.kind === "axis" ? "AP " : "GP " + section.bank + ".";
-      for (const parameter of section.parameters) {
-        const address = section.kind === "axis"
-          ? { module: module.module, kind: "axis", number: parameter.number, axis: 0 }
-          : { module: module.module, kind: "global", number: parameter.number, bank: section.bank };
-        rows.push({
-          key: (section.kind === "axis" ? "a" : "g" + section.bank + ".") + parameter.number,
-          label: prefix + parameter.number,
-          section: section.title,
-          name: parameter.name,
-          unit: parameter.unit,
-          range: parameter.min + " … " + parameter.max,
-          access: parameter.access,
-          defaultValue: parameter.default,
-          writable: parameter.access.includes("W"),
-          readable: parameter.access.includes("R"),
-          storable: parameter.access.includes("E"),
-          address: address,
-          description: parameter.description,
-        });
+      if (section.kind !== "axis") {
+        for (const parameter of section.parameters) rows.push(parameterRow(module, section, parameter, prefix, undefined, motors));
+        continue;
+      }
+      for (let motor = 0; motor < motors; motor++) {
+        for (const parameter of section.parameters) rows.push(parameterRow(module, section, parameter, prefix, motor, motors));
       }
     }
     return rows;
+  }
+
+  // An axis parameter of `motor`, or a global parameter (`motor` undefined).
+  function parameterRow(module, section, parameter, prefix, motor, motors) {
+    const address = motor !== undefined
+      ? { module: module.module, kind: "axis", number: parameter.number, axis: motor }
+      : { module: module.module, kind: "global", number: parameter.number, bank: section.bank };
+    const label = prefix + parameter.number;
+    const named = motor !== undefined && motors > 1;  // the motor said where there are more
+    return {
+      key: keyOf(address),
+      label: label,
+      title: named ? label + " (motor " + motor + ")" : label,
+      curveName: label.replace(/ /g, "") + (named ? "_m" + motor : ""),
+      motor: motor,
+      section: section.title + (named ? ", motor " + motor : ""),
+      name: parameter.name,
+      unit: parameter.unit,
+      range: parameter.min + " … " + parameter.max,
+      access: parameter.access,
+      defaultValue: parameter.default,
+      writable: parameter.access.includes("W"),
+      readable: parameter.access.includes("R"),
+      storable: parameter.access.includes("E"),
+      address: address,
+      description: parameter.description,
+    };
+  }
+
+  // A row of the module's global parameters or objects, or an axis parameter of `motor`.
+  function ofMotor(row, motor) {
+    return row.motor === undefined || row.motor === motor;
   }
 
   // --- Parameters / objects ------------------------------------------------------------------------
 
   function applyFilter() {
     const text = $("filter").value.trim().toLowerCase();
-    state.shown = state.rows.filter((row) => !text || row.name.toLowerCase().includes(text) ||
-      row.label.toLowerCase().includes(text) || row.label.toLowerCase().replace(/^(ap|gp) /, "") === text);
+    state.shown = state.rows.filter((row) => ofMotor(row, state.motor) && (!text || row.name.toLowerCase().includes(text) ||
+      row.label.toLowerCase().includes(text) || row.label.toLowerCase().replace(/^(ap|gp) /, "") === text));
     renderTable();
     subscribeShown();
   }
@@ -344,7 +401,7 @@
   function subscribeShown() {
     const limit = isCanopen() ? CANOPEN_MAX_LIVE_ROWS : MAX_LIVE_ROWS;
     const live = state.shown.filter((row) => row.readable && currentModule().protocol !== "none").slice(0, limit);
-    state.liveKeys = live.map((row) => row.key);
+    state.liveKeys = new Set(live.map((row) => row.key));
     $("live-note").textContent = live.length < state.shown.filter((row) => row.readable).length
       ? "live values for the first " + live.length + " rows; filter to see others" : "";
     request({ op: "subscribe", rate_hz: isCanopen() ? CANOPEN_LIVE_RATE_HZ : LIVE_RATE_HZ,
@@ -353,9 +410,11 @@
 
   function onUpdate(message) {
     $("sim-time").textContent = "t = " + (message.sim_time_us / 1e6).toFixed(3) + " s";
-    message.values.forEach((entry, i) => {
-      const key = state.liveKeys[i];
-      if (key === undefined || entry.module !== state.module) return;
+    // Each entry by the address it echoes: a push of the subscription before (another motor's
+    // rows, another module's) lands nowhere.
+    message.values.forEach((entry) => {
+      const key = keyOf(entry);
+      if (!state.liveKeys.has(key) || entry.module !== state.module) return;
       if (entry.value !== undefined) showValue(key, entry.value);
       else if (entry.text !== undefined) showValue(key, entry.text);
     });
@@ -498,8 +557,8 @@
     const text = $("scope-filter").value.trim().toLowerCase();
     const picked = state.scope.picked;
     const rows = scopeRows();
-    const shown = rows.filter((row) => picked.includes(row.key) || !text || row.name.toLowerCase().includes(text) ||
-      row.label.toLowerCase().includes(text));
+    const shown = rows.filter((row) => picked.includes(row.key) || (ofMotor(row, state.scope.motor) &&
+      (!text || row.name.toLowerCase().includes(text) || row.label.toLowerCase().includes(text))));
     shown.sort((a, b) => (picked.includes(b.key) ? 1 : 0) - (picked.includes(a.key) ? 1 : 0));
     const fragment = document.createDocumentFragment();
     for (const row of shown) {
@@ -512,7 +571,7 @@
       box.disabled = !box.checked && picked.length >= SCOPE_MAX_CURVES;
       box.addEventListener("change", () => pickCurve(row.key, box.checked));
       const text = document.createElement("span");
-      text.textContent = row.label + " " + row.name + (row.unit && !isCanopen() ? " (" + row.unit + ")" : "");
+      text.textContent = row.title + " " + row.name + (row.unit && !isCanopen() ? " (" + row.unit + ")" : "");
       label.append(box, " ", text);
       item.appendChild(label);
       fragment.appendChild(item);
@@ -551,8 +610,8 @@
     if (scope.instance) scope.instance.destroy();
     scope.instance = MotwinScope.create($("scope-plot"), {
       series: rows.map((row) => ({
-        name: row.label.replace(/ /g, ""),
-        label: row.label + " " + row.name,
+        name: row.curveName,
+        label: row.title + " " + row.name,
         unit: isCanopen() ? "" : row.unit,  // a CANopen dictionary names types, not units
       })),
       windowSeconds: Number($("scope-window").value),
@@ -1033,6 +1092,14 @@
     }
     $("module-picker").addEventListener("change", (event) => chooseModule(Number(event.target.value)));
     $("filter").addEventListener("input", applyFilter);
+    $("motor-picker").addEventListener("change", (event) => {
+      state.motor = Number(event.target.value);
+      applyFilter();
+    });
+    $("scope-motor").addEventListener("change", (event) => {
+      state.scope.motor = Number(event.target.value);
+      renderScopeChoices();
+    });
     $("store-all").addEventListener("click", () => storeShown("store"));
     $("restore-all").addEventListener("click", () => storeShown("restore"));
     $("console-form").addEventListener("submit", onConsoleSubmit);

@@ -166,12 +166,34 @@
 
   // --- Setup --------------------------------------------------------------------------------------
 
-  // The rows a channel can sample: readable axis parameters of axis 0 and global parameters of
-  // banks 0 and 2 (SET_CHANNEL's types 1 and 8; docs/datalogger.md "Channels").
+  // The rows a channel can sample: readable axis parameters of each motor and global parameters
+  // of banks 0 and 2 (SET_CHANNEL's types 1 and 8; docs/datalogger.md "Channels").
   function channelRows() {
     const rows = console_().rows || [];
     return rows.filter((row) => row.readable && row.address && row.address.kind &&
-      (row.address.kind === "axis" ? row.address.axis === 0 : kDataloggerBanks.includes(row.address.bank)));
+      (row.address.kind === "axis" || kDataloggerBanks.includes(row.address.bank)));
+  }
+
+  // A channel's choices: on a module of more than one motor, grouped by motor (then the global
+  // parameters), so that a channel picks its motor with its parameter.
+  function addChannelOptions(select, rows) {
+    const motors = new Set(rows.filter((row) => row.motor !== undefined).map((row) => row.motor));
+    const groups = new Map();
+    for (const row of rows) {
+      const option = new Option(row.title + " " + row.name + (row.unit ? " (" + row.unit + ")" : ""), row.key);
+      if (motors.size < 2) {
+        select.add(option);
+        continue;
+      }
+      const group = row.motor !== undefined ? "Motor " + row.motor : "Global parameters";
+      if (!groups.has(group)) {
+        const element = document.createElement("optgroup");
+        element.label = group;
+        select.appendChild(element);
+        groups.set(group, element);
+      }
+      groups.get(group).appendChild(option);
+    }
   }
 
   function renderSetup() {
@@ -185,10 +207,7 @@
       select.className = "datalogger-channel";
       select.setAttribute("aria-label", "Channel " + (c + 1));
       select.add(new Option("–", ""));
-      for (const row of rows) {
-        const option = new Option(row.label + " " + row.name + (row.unit ? " (" + row.unit + ")" : ""), row.key);
-        select.add(option);
-      }
+      addChannelOptions(select, rows);
       if (defaults[c] && rows.some((row) => row.key === defaults[c])) select.value = defaults[c];
       select.addEventListener("change", updateSetup);
       const label = document.createElement("label");
@@ -233,7 +252,7 @@
     const trigger = $("datalogger-trigger");
     const chosen = trigger.value;
     trigger.replaceChildren(new Option("none (at once)", ""));
-    picked.forEach((row, i) => trigger.add(new Option(row.label + " " + row.name, String(i))));
+    picked.forEach((row, i) => trigger.add(new Option(row.title + " " + row.name, String(i))));
     if (Number(chosen) < picked.length) trigger.value = chosen;
     showNote();
   }
@@ -344,7 +363,7 @@
     for (let k = 0; k < read.samples; k++) times[k] = Number(((k - read.pretrigger_samples) * period_s).toFixed(9));
     const title = state.module.name + ": datalogger, " + formatHz(read.base_rate_hz / (run.prescaler + 1)) +
       (run.trigger ? ", trigger at 0 s" : "");
-    const series = run.rows.map((row) => ({ name: row.label.replace(/ /g, ""), label: row.label + " " + row.name, unit: row.unit }));
+    const series = run.rows.map((row) => ({ name: row.curveName, label: row.title + " " + row.name, unit: row.unit }));
     const same = state.scope && state.scope.title === title && state.scope.series.length === series.length &&
       state.scope.series.every((s, i) => s.name === series[i].name);
     if (!same) {

@@ -404,12 +404,22 @@ struct RequestError {
   std::string message;
 };
 
+// An axis parameter of a motor the module does not have: refused before anything is sent (a TMCL
+// host that sends it gets status 4, invalid value).
+std::string motor_error(const ConsoleTarget& target, uint8_t motor) {
+  return "\"axis\": no motor " + std::to_string(motor) + " on " + target.name + " (" +
+         (target.motor_count == 1 ? std::string("one motor: 0")
+                                  : std::to_string(target.motor_count) + " motors: 0.." +
+                                        std::to_string(target.motor_count - 1)) +
+         ")";
+}
+
 }  // namespace
 
 // --- Targets -----------------------------------------------------------------------------------
 
 ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
-                          std::string_view firmware_generation, host::TmclHostService* service,
+                          std::string_view firmware_generation, uint8_t motor_count, host::TmclHostService* service,
                           host::TmclCanNode* can_node) {
   ConsoleTarget target;
   target.name = std::move(name);
@@ -420,6 +430,7 @@ ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string 
   target.listing = listing ? std::move(*listing) : descriptor.listing();
   target.tmcl = service;
   target.tmcl_can = can_node;
+  target.motor_count = motor_count;
   return target;
 }
 
@@ -432,6 +443,12 @@ ConsoleTarget canopen_target(const host::ModuleDescriptor& descriptor, std::stri
   target.firmware = std::move(firmware);
   target.listing = descriptor.listing();
   target.canopen_node_id = node_id;
+  // Its axes: the dictionary's objects name theirs (6041, 6841, 7041 on the TMCM-3216).
+  for (const host::ObjectSection& section : target.listing.object_sections) {
+    for (const host::DictionaryObject& object : section.objects) {
+      target.motor_count = std::max<uint8_t>(target.motor_count, static_cast<uint8_t>(object.axis + 1));
+    }
+  }
   return target;
 }
 
@@ -693,6 +710,7 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
                      {"product", target.product_name},
                      {"firmware", target.firmware},
                      {"protocol", console_.port(i) != nullptr ? "tmcl" : target.canopen_node_id ? "canopen" : "none"},
+                     {"motors", target.motor_count},
                      {"sections", listing_json(target)}};
       if (target.tmcl == nullptr && target.tmcl_can != nullptr && console_.port(i) != nullptr) {
         const tmcl::CanSettings ids = target.tmcl_can->settings();
@@ -756,6 +774,10 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
       }
       item.number = static_cast<uint8_t>(*number);
       item.motor_bank = static_cast<uint8_t>(motor_bank.value_or(0));
+      if (item.axis && item.motor_bank >= target->motor_count) {
+        error = motor_error(*target, item.motor_bank);
+        return std::nullopt;
+      }
       item.echo["kind"] = kind_text;
       item.echo["number"] = item.number;
       item.echo[item.axis ? "axis" : "bank"] = item.motor_bank;
@@ -1037,6 +1059,9 @@ class WebConsole::Impl::Session final : public host::web::WebSessionHandler {
     if (console_.port(index) == nullptr) return "module " + target->name + " takes no TMCL from the console: no datalogger";
     std::variant<DataloggerPlan, std::string> plan = parse_datalogger_request(request);
     if (const std::string* refused = std::get_if<std::string>(&plan)) return *refused;
+    for (const DataloggerChannel& channel : std::get<DataloggerPlan>(plan).channels) {
+      if (channel.axis && channel.motor_bank >= target->motor_count) return motor_error(*target, channel.motor_bank);
+    }
     TmclRequests* port = console_.port(index);
     DataloggerLink link;
     link.request = [port](const tmcl::Instruction& instruction, std::function<void(const DataloggerAnswer&)> done) {

@@ -40,6 +40,9 @@ struct ConsoleTarget {
   host::TmclHostService* tmcl = nullptr;  // a TMCL module served directly
   host::TmclCanNode* tmcl_can = nullptr;  // or a TMCL module on the bus: reached by TMCL over CAN
   uint8_t module_address = 1;             // of its TMCL requests
+  // Its motors (TMCL motor numbers 0..motor_count - 1, TmclDevice::motor_count(); a CANopen node:
+  // the axes its dictionary lists). An axis parameter of a motor beyond them is refused.
+  uint8_t motor_count = 1;
   std::optional<uint8_t> canopen_node_id;  // a CANopen node on the bus
   ConsoleWorld world;                      // its simulated world (ops "world", "world_set")
 };
@@ -79,9 +82,10 @@ class WebConsole {
 
 // The console's targets for `motwin serve`: the module itself (TMCL through `service`, or a
 // CANopen node), or each node of a group. A TMCL module that is only a node of a bus is reached
-// by TMCL over CAN through `can_node` (tmcl_can_port.h); without a bus, not at all.
+// by TMCL over CAN through `can_node` (tmcl_can_port.h); without a bus, not at all. `motor_count`:
+// the module's TmclDevice::motor_count().
 ConsoleTarget tmcl_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
-                          std::string_view firmware_generation, host::TmclHostService* service,
+                          std::string_view firmware_generation, uint8_t motor_count, host::TmclHostService* service,
                           host::TmclCanNode* can_node = nullptr);
 ConsoleTarget canopen_target(const host::ModuleDescriptor& descriptor, std::string name, std::string firmware,
                              uint8_t node_id);

@@ -46,11 +46,13 @@ class FakeWebConnection final : public host::web::WebConnection {
 };
 
 // A module by its registry name that logs nowhere; `motor` as `--motor` names it (empty: the
-// module's default).
-inline host::MakeModuleResult make_quiet_module(const char* name, const std::string& motor = "") {
+// module's default), `firmware` as `--firmware` (empty: its default).
+inline host::MakeModuleResult make_quiet_module(const char* name, const std::string& motor = "",
+                                                const std::string& firmware = "") {
   host::ModuleOptions options;
   options.log = [](const std::string&) {};
   options.motor = motor;
+  options.firmware = firmware;
   return host::make_module(name, options);
 }
 
@@ -69,6 +71,7 @@ struct WebConsoleRigSetup {
   using TargetAdapter = std::function<void(WebConsoleRig& rig, tools::web::ConsoleTarget& target)>;
 
   std::string motor;     // make_quiet_module's
+  std::string firmware;  // make_quiet_module's: "tmcl" for the TMCM-3216's TMCL firmware
   bool can_bus = false;  // the module's CAN node on a virtual bus (a CANopen node always is)
   ReplyWait reply_wait = ReplyWait::kLoopTurns;
   // Changes the module's console target before the console is made (a world, TMCL over CAN).
@@ -76,6 +79,10 @@ struct WebConsoleRigSetup {
 
   WebConsoleRigSetup& with_motor(std::string name) {
     motor = std::move(name);
+    return *this;
+  }
+  WebConsoleRigSetup& with_firmware(std::string name) {
+    firmware = std::move(name);
     return *this;
   }
   WebConsoleRigSetup& with_can_bus() {
@@ -99,7 +106,7 @@ class WebConsoleRig {
   using Json = nlohmann::json;
 
   explicit WebConsoleRig(const char* module_name, WebConsoleRigSetup setup = {}) : wait_(setup.reply_wait) {
-    host::MakeModuleResult made = make_quiet_module(module_name, setup.motor);
+    host::MakeModuleResult made = make_quiet_module(module_name, setup.motor, setup.firmware);
     EXPECT_TRUE(made) << made.error();
     module_ = std::move(*made);
     runtime_ = std::make_unique<host::HostRuntime>(*module_, host::Pacing::fast());
@@ -111,7 +118,8 @@ class WebConsoleRig {
     std::vector<tools::web::ConsoleTarget> targets;
     if (module_->has_tmcl()) {
       targets.push_back(tools::web::tmcl_target(descriptor, std::string(module_->name()),
-                                                std::string(module_->firmware_version()), "", &runtime_->service()));
+                                                std::string(module_->firmware_version()), setup.firmware,
+                                                module_->engine().device().motor_count(), &runtime_->service()));
     } else {
       targets.push_back(tools::web::canopen_target(descriptor, std::string(module_->name()),
                                                    std::string(module_->firmware_version()), 1));
