@@ -68,12 +68,15 @@ struct RealTimeFactorSummary {
   double goal;                 // least acceptable real-time factor
   int name_width;              // of the case name column
   // Cases held to another case of the same run: `name` runs at least `least_ratio` of `reference`'s
-  // real-time factor (the TMCM-1636's CANopen firmware against its TMCL firmware on one motion).
+  // real-time factor, and at most `most_ratio` of it when that is set (the TMCM-1636's CANopen
+  // firmware against its TMCL firmware on one motion; the TMCM-3216's TMCL firmware within 10 %
+  // of its CANopen firmware).
   struct Comparison {
     const char* name;
     const char* reference;
     const char* label;  // "canopen/tmcl"
     double least_ratio;
+    double most_ratio = 0.0;  // 0: no upper bound
   };
   std::vector<Comparison> comparisons = {};
 };
@@ -96,7 +99,13 @@ class RealTimeFactorReporter final : public SummaryReporter {
         const auto reference = factor_.find(c.reference);
         if (name != c.name || reference == factor_.end() || reference->second <= 0.0) continue;
         const double ratio = factor / reference->second;
-        std::printf("; %s %.3f, goal >= %.2f: %s", c.label, ratio, c.least_ratio, ratio >= c.least_ratio ? "met" : "NOT met");
+        const bool bounded = c.most_ratio > 0.0;
+        const bool met = ratio >= c.least_ratio && (!bounded || ratio <= c.most_ratio);
+        if (bounded) {
+          std::printf("; %s %.3f, goal %.2f..%.2f: %s", c.label, ratio, c.least_ratio, c.most_ratio, met ? "met" : "NOT met");
+        } else {
+          std::printf("; %s %.3f, goal >= %.2f: %s", c.label, ratio, c.least_ratio, met ? "met" : "NOT met");
+        }
       }
       std::printf("\n");
     }

@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "sim/stepper_plant.h"
+#include "support/tmcl_command.h"
 #include "support/tmcm3216_tmcl_rig.h"
 
 namespace motwin::testing {

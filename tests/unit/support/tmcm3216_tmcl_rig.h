@@ -10,7 +10,7 @@
 #include "core/tmcl/engine.h"
 #include "core/tmcl/serial_link.h"
 #include "sim/modules/tmcm3216/tmcm3216_sim_board.h"
-#include "tmcl_command.h"
+#include "tmcl_serial_command.h"
 
 namespace motwin::testing {
 
