@@ -205,8 +205,10 @@ def test_tmcm1636_v113_image(motwin):
         expect_reply(client.request(MVP, MVP_ABS, 0, 250), MVP, STATUS_OK, what="MVP ABS 250")
         client.wait_for("GAP 55 (position reached)", lambda: client.gap(55) == 1, MOVE_TIMEOUT, interval=0.05)
         check_equal(client.gap(50), 250, "GAP 50 (target position, in position scaler units)")
-        position = client.gap(52)
-        check(abs(position - 250) <= 1, f"GAP 52 (actual position) {position}, not within 1 of 250")
+        # AP 55 rises inside the target window (AP 53, 54) while the ramp's last counts are still
+        # to come; a poll that lands there (a busy host slows qemu) reads 248: wait for the end.
+        client.wait_for("GAP 52 (actual position) within 1 of 250", lambda: abs(client.gap(52) - 250) <= 1,
+                        MOVE_TIMEOUT, interval=0.05)
 
 
 def test_tmcm142_moves_and_speaks_ascii(motwin):
