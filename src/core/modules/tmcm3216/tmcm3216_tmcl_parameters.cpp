@@ -16,50 +16,35 @@ using params::Unit;
 using tmcl::Status;
 using Module = Tmcm3216Tmcl;
 
-// A field of the EightPoint shape (2010..2018 of the CANopen firmware) of the motor's axis.
+// The parts of a motor's axis that rows bind fields of: the EightPoint shape (2010..2018 of the
+// CANopen firmware), the stepper's settings (its per-axis objects), the TMCL settings.
+constexpr Tmcm3216DriveObjects& shape_of(Tmcm3216TmclAxis& axis) { return axis.config.shape; }
+constexpr StepperObjects& stepper_of(Tmcm3216TmclAxis& axis) { return axis.stepper.objects; }
+constexpr TmclAxisConfig& config_of(Tmcm3216TmclAxis& axis) { return axis.config; }
+
+// A field of any integer width of one part of the motor's axis; with `Valid`, values inside the
+// row's range that the firmware refuses answer status 4 (the holes of 2097 and 20A2, AP 193's
+// option combinations).
+template <auto Part, auto Field, auto Valid = nullptr>
+constexpr Binding<Module> part_field() {
+  using Value = std::remove_cvref_t<decltype(Part(std::declval<Tmcm3216TmclAxis&>()).*Field)>;
+  return {[](Module& m, uint8_t motor) { return static_cast<int32_t>(Part(m.axis(motor)).*Field); },
+          [](Module& m, uint8_t motor, int32_t value) {
+            if constexpr (!std::is_same_v<decltype(Valid), std::nullptr_t>) {
+              if (!Valid(value)) return Status::kInvalidValue;
+            }
+            Part(m.axis(motor)).*Field = static_cast<Value>(value);
+            return Status::kOk;
+          }};
+}
 template <auto Field>
-constexpr Binding<Module> shape_field() {
-  using Value = std::remove_cvref_t<decltype(std::declval<Tmcm3216DriveObjects&>().*Field)>;
-  return {[](Module& m, uint8_t motor) { return static_cast<int32_t>(m.axis(motor).config.shape.*Field); },
-          [](Module& m, uint8_t motor, int32_t value) {
-            m.axis(motor).config.shape.*Field = static_cast<Value>(value);
-            return Status::kOk;
-          }};
-}
-
-// A setting of the motor's stepper (the CANopen firmware's per-axis object of the same meaning).
+constexpr Binding<Module> shape_field() { return part_field<&shape_of, Field>(); }
 template <auto Field>
-constexpr Binding<Module> stepper_field() {
-  using Value = std::remove_cvref_t<decltype(std::declval<StepperObjects&>().*Field)>;
-  return {[](Module& m, uint8_t motor) { return static_cast<int32_t>(m.axis(motor).stepper.objects.*Field); },
-          [](Module& m, uint8_t motor, int32_t value) {
-            m.axis(motor).stepper.objects.*Field = static_cast<Value>(value);
-            return Status::kOk;
-          }};
-}
-
-// A setting of the motor's stepper whose range has a hole the driver refuses (status 4).
-template <auto Field, bool (*Valid)(int64_t)>
-constexpr Binding<Module> checked_stepper_field() {
-  using Value = std::remove_cvref_t<decltype(std::declval<StepperObjects&>().*Field)>;
-  return {[](Module& m, uint8_t motor) { return static_cast<int32_t>(m.axis(motor).stepper.objects.*Field); },
-          [](Module& m, uint8_t motor, int32_t value) {
-            if (!Valid(value)) return Status::kInvalidValue;
-            m.axis(motor).stepper.objects.*Field = static_cast<Value>(value);
-            return Status::kOk;
-          }};
-}
-
-// An axis setting with values in its range the firmware refuses (status 4).
-template <auto Field, bool (*Valid)(int32_t)>
-constexpr Binding<Module> checked_config_field() {
-  return {[](Module& m, uint8_t motor) { return m.axis(motor).config.*Field; },
-          [](Module& m, uint8_t motor, int32_t value) {
-            if (!Valid(value)) return Status::kInvalidValue;
-            m.axis(motor).config.*Field = value;
-            return Status::kOk;
-          }};
-}
+constexpr Binding<Module> stepper_field() { return part_field<&stepper_of, Field>(); }
+template <auto Field, auto Valid>
+constexpr Binding<Module> checked_stepper_field() { return part_field<&stepper_of, Field, Valid>(); }
+template <auto Field, auto Valid>
+constexpr Binding<Module> checked_config_field() { return part_field<&config_of, Field, Valid>(); }
 
 // A reading of the motor's stepper.
 template <auto Get>
